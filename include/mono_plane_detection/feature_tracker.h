@@ -1,0 +1,136 @@
+// Feature tracking of paper section II: Shi-Tomasi corners followed by pyramidal
+// Lucas-Kanade, a new search on 2/3 loss and every N frames, and matching of new
+// corners to old points so that tracks keep their ids. ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace mono_plane_detection {
+
+struct TrackerParams {
+  // Shi-Tomasi search (paper II-B).
+  int max_features = 50;          // corners kept per image
+  double min_distance_px = 15.0;  // minimum spacing between corners
+  double quality_level = 0.01;    // fraction of the strongest corner's score
+  int block_size = 3;             // px, neighbourhood of the corner score
+
+  // Pyramidal Lucas-Kanade (paper II-C).
+  int pyramid_levels = 5;      // levels including full resolution (paper: 5)
+  int window_size_px = 21;     // paper: 3; 21 measured best (README, "window size")
+  int max_iterations = 30;     // LK termination: iterations per level
+  double epsilon_px = 0.01;    // LK termination: step size
+  double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
+
+  // When to search again (paper II-C).
+  double redetect_lost_fraction = 2.0 / 3.0;  // of the points found at the last search
+  int redetect_every = 10;                    // frames between searches at the latest
+
+  // Matching new corners to existing points (paper II-D).
+  double match_radius_px = 3.0;
+
+  // Beyond the paper.
+  bool forward_backward_check = true;   // track back and drop points that do not return
+  double forward_backward_max_px = 1.0;  // allowed round-trip error
+  bool reanchor_on_search = true;       // pull live points back onto their corner
+  int reanchor_window_px = 3;           // half-size of the cornerSubPix window
+  double reanchor_max_shift_px = 1.0;   // larger corrections are not trusted
+  bool mask_existing = true;            // no new corner within min_distance of a live point
+  bool reidentify = true;               // give a lost point its old id when it comes back
+  int reid_memory_frames = 150;         // how long a lost point can come back
+  int reid_max_hamming = 40;            // of 256 ORB bits
+  double reid_ratio = 0.8;              // best / second-best Hamming distance
+  double reid_max_radius_px = 40.0;     // from where the image motion says it went
+};
+
+// One record of the paper's state arrays.
+struct TrackedPoint {
+  std::uint64_t id = 0;  // unique, increasing, never reused
+  cv::Point2f uv;        // pixel position in the current image
+  // Estimated 3D position in metres (map frame); NaN until the plane side fills it.
+  cv::Point3f position{std::numeric_limits<float>::quiet_NaN(),
+                       std::numeric_limits<float>::quiet_NaN(),
+                       std::numeric_limits<float>::quiet_NaN()};
+  bool is_new = false;           // found by the search on this image
+  bool is_tracked = false;       // followed by Lucas-Kanade from the previous image
+  bool is_reidentified = false;  // new corner that got back the id of a lost point
+  int prev_index = -1;           // index in the previous state, -1 if new
+  int age = 0;                   // images since the point was first seen (0 when new)
+};
+
+// What happened on the last processed image.
+struct TrackerFrameStats {
+  int tracked = 0;       // points followed from the previous image
+  int lost = 0;          // points of the previous image not followed
+  int added = 0;         // points with a new id
+  int matched = 0;       // new corners that matched a live point (kept its id)
+  int reidentified = 0;  // new corners that got back a lost id
+  bool searched = false;
+};
+
+// Paper II-C: search again when the share of points lost since the last search reaches
+// lost_fraction, when frames_since_search reaches every_n, or when nothing is left.
+bool shouldSearch(int found_at_last_search, int alive, int frames_since_search,
+                  const TrackerParams& params);
+
+// Paper II-D: for each corner, the index of the point within radius it matches, or -1.
+// When several corners pick the same point, the closest pair wins.
+std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,
+                                      const std::vector<cv::Point2f>& points,
+                                      double radius_px);
+
+class FeatureTracker {
+ public:
+  explicit FeatureTracker(const TrackerParams& params = TrackerParams());
+
+  // Processes the next image (CV_8UC1, non-empty; throws std::invalid_argument
+  // otherwise) and returns the new current state. An image of another size than the
+  // previous one starts over (reset).
+  const std::vector<TrackedPoint>& process(const cv::Mat& gray);
+
+  // Forgets every point and image; ids keep increasing so they are never reused.
+  void reset();
+
+  const std::vector<TrackedPoint>& current() const { return current_; }
+  const std::vector<TrackedPoint>& previous() const { return previous_; }
+  const TrackerFrameStats& lastStats() const { return stats_; }
+  const TrackerParams& params() const { return params_; }
+  long frameCount() const { return frame_count_; }
+
+ private:
+  struct LostPoint {
+    std::uint64_t id;
+    cv::Point2f uv;
+    int age;
+    long lost_at_frame;
+    cv::Mat descriptor;
+  };
+
+  void trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size);
+  void search(const cv::Mat& gray);
+  void reanchor(const cv::Mat& gray);
+  cv::Mat searchMask(const cv::Size& size) const;
+  void moveLostWithImage();
+  void reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& fresh);
+  void rememberLost(const TrackedPoint& point);
+  void refreshDescriptors(const cv::Mat& gray);
+
+  TrackerParams params_;
+  std::vector<TrackedPoint> previous_;
+  std::vector<TrackedPoint> current_;
+  TrackerFrameStats stats_;
+  std::vector<cv::Mat> previous_pyramid_;
+  cv::Size image_size_;
+  std::uint64_t next_id_ = 1;
+  long frame_count_ = 0;
+  int found_at_last_search_ = 0;
+  int frames_since_search_ = 0;
+  std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
+  std::vector<LostPoint> lost_;                              // re-identification pool
+};
+
+}  // namespace mono_plane_detection

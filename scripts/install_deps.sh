@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages the build, the tests and the demo need.
+# Idempotent and quiet when everything is already there.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake catkin
+  ros-message-generation ros-message-runtime libroscpp-dev
+  libnodeletlib-dev libnodeletlib-tools
+  libimage-transport-dev image-transport-tools libcv-bridge-dev
+  libdiagnostic-updater-dev ros-diagnostic-msgs python3-diagnostic-msgs
+  librostest-dev python3-rostest libgtest-dev
+  python3-roslaunch python3-rosmaster python3-rostopic rosbash
+  librosbag-dev python3-rosbag
+  ros-std-msgs ros-sensor-msgs python3-sensor-msgs
+  libopencv-dev libeigen3-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "install_deps: installing ${#missing[@]} package(s): ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

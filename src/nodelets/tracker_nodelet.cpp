@@ -1,0 +1,223 @@
+// Thin ROS glue around FeatureTracker: image in, Tracks and a debug image out.
+#include <atomic>
+#include <memory>
+#include <mutex>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <image_transport/image_transport.h>
+#include <nodelet/nodelet.h>
+#include <pluginlib/class_list_macros.hpp>
+#include <ros/ros.h>
+
+#include "image_input.h"
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/draw_tracks.h"
+#include "mono_plane_detection/feature_tracker.h"
+
+namespace mono_plane_detection {
+namespace {
+
+TrackerParams readParams(const ros::NodeHandle& pnh) {
+  TrackerParams p;
+  pnh.param("max_features", p.max_features, p.max_features);
+  pnh.param("min_distance_px", p.min_distance_px, p.min_distance_px);
+  pnh.param("quality_level", p.quality_level, p.quality_level);
+  pnh.param("block_size", p.block_size, p.block_size);
+  pnh.param("pyramid_levels", p.pyramid_levels, p.pyramid_levels);
+  pnh.param("window_size_px", p.window_size_px, p.window_size_px);
+  pnh.param("max_iterations", p.max_iterations, p.max_iterations);
+  pnh.param("epsilon_px", p.epsilon_px, p.epsilon_px);
+  pnh.param("min_eigen_threshold", p.min_eigen_threshold, p.min_eigen_threshold);
+  pnh.param("redetect_lost_fraction", p.redetect_lost_fraction, p.redetect_lost_fraction);
+  pnh.param("redetect_every", p.redetect_every, p.redetect_every);
+  pnh.param("match_radius_px", p.match_radius_px, p.match_radius_px);
+  pnh.param("forward_backward_check", p.forward_backward_check, p.forward_backward_check);
+  pnh.param("forward_backward_max_px", p.forward_backward_max_px, p.forward_backward_max_px);
+  pnh.param("reanchor_on_search", p.reanchor_on_search, p.reanchor_on_search);
+  pnh.param("reanchor_window_px", p.reanchor_window_px, p.reanchor_window_px);
+  pnh.param("reanchor_max_shift_px", p.reanchor_max_shift_px, p.reanchor_max_shift_px);
+  pnh.param("mask_existing", p.mask_existing, p.mask_existing);
+  pnh.param("reidentify", p.reidentify, p.reidentify);
+  pnh.param("reid_memory_frames", p.reid_memory_frames, p.reid_memory_frames);
+  pnh.param("reid_max_hamming", p.reid_max_hamming, p.reid_max_hamming);
+  pnh.param("reid_ratio", p.reid_ratio, p.reid_ratio);
+  pnh.param("reid_max_radius_px", p.reid_max_radius_px, p.reid_max_radius_px);
+  return p;
+}
+
+// Values that would make OpenCV assert are replaced by the defaults, loudly.
+TrackerParams sanitized(TrackerParams p, const std::string& name) {
+  const TrackerParams d;
+  auto fix = [&](bool bad, const char* what, auto& value, auto fallback) {
+    if (!bad) return;
+    ROS_ERROR_STREAM_NAMED(name, "parameter " << what << " = " << value
+                                              << " is invalid; using " << fallback);
+    value = fallback;
+  };
+  fix(p.max_features < 1, "max_features", p.max_features, d.max_features);
+  fix(p.quality_level <= 0 || p.quality_level >= 1, "quality_level", p.quality_level,
+      d.quality_level);
+  fix(p.block_size < 1, "block_size", p.block_size, d.block_size);
+  fix(p.pyramid_levels < 1, "pyramid_levels", p.pyramid_levels, d.pyramid_levels);
+  fix(p.window_size_px < 3, "window_size_px", p.window_size_px, d.window_size_px);
+  fix(p.reanchor_window_px < 1, "reanchor_window_px", p.reanchor_window_px, d.reanchor_window_px);
+  fix(p.max_iterations < 1, "max_iterations", p.max_iterations, d.max_iterations);
+  return p;
+}
+
+TracksPtr toMessage(const std_msgs::Header& header, const cv::Size& size,
+                    const std::vector<TrackedPoint>& points, bool searched) {
+  TracksPtr msg(new Tracks);
+  msg->header = header;
+  msg->width = size.width;
+  msg->height = size.height;
+  msg->searched = searched;
+  const size_t n = points.size();
+  msg->id.reserve(n);
+  msg->u.reserve(n);
+  msg->v.reserve(n);
+  msg->prev_index.reserve(n);
+  msg->flags.reserve(n);
+  msg->age.reserve(n);
+  for (const auto& p : points) {
+    msg->id.push_back(p.id);
+    msg->u.push_back(p.uv.x);
+    msg->v.push_back(p.uv.y);
+    msg->prev_index.push_back(p.prev_index);
+    msg->flags.push_back((p.is_new ? Tracks::FLAG_NEW : 0) |
+                         (p.is_tracked ? Tracks::FLAG_TRACKED : 0) |
+                         (p.is_reidentified ? Tracks::FLAG_REIDENTIFIED : 0));
+    msg->age.push_back(p.age);
+  }
+  return msg;
+}
+
+}  // namespace
+
+class TrackerNodelet : public nodelet::Nodelet {
+ public:
+  ~TrackerNodelet() override {
+    std::lock_guard<std::mutex> lock(connect_mutex_);
+    image_sub_.shutdown();
+  }
+
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    tracker_ = FeatureTracker(sanitized(readParams(pnh), getName()));
+    pnh.param("lazy", lazy_, true);
+    pnh.param<std::string>("image_transport", transport_, "raw");
+
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("camera");
+    rate_diagnostic_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+        diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
+    pnh.param("expected_min_rate_hz", min_rate_, 5.0);
+    pnh.param("expected_max_rate_hz", max_rate_, 100.0);
+    updater_->add(*rate_diagnostic_);
+    updater_->add("tracking", this, &TrackerNodelet::diagnose);
+    diagnostic_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
+      updater_->update();
+    });
+
+    it_ = std::make_unique<image_transport::ImageTransport>(nh);
+    std::lock_guard<std::mutex> lock(connect_mutex_);
+    auto connect = [this](const auto&) { updateSubscription(); };
+    tracks_pub_ = nh.advertise<Tracks>("tracks", 10, connect, connect);
+    debug_pub_ = it_->advertise("debug_image", 1, connect, connect);
+    if (!lazy_) subscribe();
+  }
+
+  void subscribe() {
+    image_sub_ = it_->subscribe("image", 5, &TrackerNodelet::imageCallback, this,
+                                image_transport::TransportHints(transport_));
+  }
+
+  // Lazy subscription: nobody listens, nothing is tracked. Tracking restarts fresh
+  // when a listener comes back, as image_proc's nodelets do.
+  void updateSubscription() {
+    std::lock_guard<std::mutex> lock(connect_mutex_);
+    if (!lazy_) return;
+    const bool wanted = tracks_pub_.getNumSubscribers() > 0 || debug_pub_.getNumSubscribers() > 0;
+    if (wanted && !image_sub_) {
+      subscribe();
+    } else if (!wanted && image_sub_) {
+      image_sub_.shutdown();
+      std::lock_guard<std::mutex> state_lock(state_mutex_);
+      tracker_.reset();
+      last_stamp_ = ros::Time();
+    }
+  }
+
+  void imageCallback(const sensor_msgs::ImageConstPtr& msg) {
+    rate_diagnostic_->tick();
+    const GreyImage grey = toGrey(msg);
+    if (!grey.image) {
+      ++dropped_;
+      NODELET_ERROR_THROTTLE(5.0, "dropping image: %s", grey.error.c_str());
+      return;
+    }
+    TracksPtr tracks;
+    std::vector<TrackedPoint> points;
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      if (!last_stamp_.isZero() && msg->header.stamp < last_stamp_) {
+        NODELET_WARN("image stamp %.3f is before the previous one (%.3f): time went "
+                     "backwards (bag loop?), tracking starts over",
+                     msg->header.stamp.toSec(), last_stamp_.toSec());
+        tracker_.reset();
+      }
+      last_stamp_ = msg->header.stamp;
+      points = tracker_.process(grey.image->image);
+      const TrackerFrameStats& stats = tracker_.lastStats();
+      searches_ += stats.searched ? 1 : 0;
+      lost_ += stats.lost;
+      tracked_now_ = static_cast<int>(points.size());
+      tracks = toMessage(msg->header, grey.image->image.size(), points, stats.searched);
+    }
+    tracks_pub_.publish(tracks);  // shared pointer: no copy inside one manager
+
+    if (debug_pub_.getNumSubscribers() > 0) {
+      cv_bridge::CvImage debug(msg->header, "bgr8", drawTracks(grey.image->image, points));
+      debug_pub_.publish(debug.toImageMsg());
+    }
+  }
+
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    status.summary(dropped_ > 0 ? diagnostic_msgs::DiagnosticStatus::WARN
+                                : diagnostic_msgs::DiagnosticStatus::OK,
+                   dropped_ > 0 ? "images dropped" : "tracking");
+    status.add("points tracked", tracked_now_);
+    status.add("points lost (total)", lost_);
+    status.add("searches (total)", searches_);
+    status.add("images dropped (total)", static_cast<long>(dropped_));
+  }
+
+  FeatureTracker tracker_;
+  bool lazy_ = true;
+  std::string transport_;
+  std::unique_ptr<image_transport::ImageTransport> it_;
+  image_transport::Subscriber image_sub_;
+  ros::Publisher tracks_pub_;
+  image_transport::Publisher debug_pub_;
+
+  std::mutex connect_mutex_;  // subscription changes
+  std::mutex state_mutex_;    // tracker and counters
+  ros::Time last_stamp_;
+  std::atomic<long> dropped_{0};
+  long lost_ = 0;
+  long searches_ = 0;
+  int tracked_now_ = 0;
+
+  double min_rate_ = 5.0, max_rate_ = 100.0;
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_diagnostic_;
+  ros::Timer diagnostic_timer_;
+};
+
+}  // namespace mono_plane_detection
+
+PLUGINLIB_EXPORT_CLASS(mono_plane_detection::TrackerNodelet, nodelet::Nodelet)

@@ -1,0 +1,209 @@
+// Drives TrackerNodelet with images of known motion and bad input; checks `tracks`.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/synthetic_views.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+const cv::Size kView(640, 480);
+const cv::Point2d kCentred(-180, -160);
+
+class TrackerNodeletTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 10);
+    tracks_sub_ = nh_.subscribe("tracks", 50, &TrackerNodeletTest::onTracks, this);
+    // The nodelet subscribes lazily: wait until our listener made it subscribe.
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
+    while (ros::ok() && image_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) {
+      ros::spinOnce();
+      ros::WallDuration(0.05).sleep();
+    }
+    ASSERT_GT(image_pub_.getNumSubscribers(), 0u) << "tracker never subscribed to image";
+  }
+
+  void onTracks(const TracksConstPtr& msg) { received_[msg->header.stamp.toNSec()] = msg; }
+
+  sensor_msgs::ImagePtr makeImage(const cv::Mat& image, const std::string& encoding,
+                                  double stamp) {
+    std_msgs::Header header;
+    header.stamp = ros::Time(stamp);
+    header.frame_id = "camera_optical";
+    return cv_bridge::CvImage(header, encoding, image).toImageMsg();
+  }
+
+  // Publishes and waits for the Tracks of this stamp; null when none came.
+  TracksConstPtr send(const sensor_msgs::ImagePtr& msg, double timeout = 5.0) {
+    image_pub_.publish(msg);
+    const auto key = msg->header.stamp.toNSec();
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (ros::ok() && ros::WallTime::now() < deadline) {
+      ros::spinOnce();
+      auto it = received_.find(key);
+      if (it != received_.end()) return it->second;
+      ros::WallDuration(0.005).sleep();
+    }
+    return nullptr;
+  }
+
+  cv::Mat view(const cv::Point2d& shift) {
+    static const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
+    return warpView(texture, similarity(0, {}, kCentred + shift), kView);
+  }
+
+  ros::NodeHandle nh_;
+  ros::Publisher image_pub_;
+  ros::Subscriber tracks_sub_;
+  std::map<uint64_t, TracksConstPtr> received_;
+  double stamp_ = 100.0;
+};
+
+TEST_F(TrackerNodeletTest, TracksFollowKnownMotion) {
+  const cv::Point2d step(1.5, -0.5);
+  std::map<uint64_t, cv::Point2d> texture_of;  // id -> shift-free position at birth
+  std::set<uint64_t> first_ids;
+  double error_sum = 0;
+  int error_count = 0;
+  for (int k = 0; k < 20; ++k) {
+    const cv::Point2d shift = k * step;
+    auto tracks = send(makeImage(view(shift), "mono8", stamp_ += 0.1));
+    ASSERT_TRUE(tracks) << "no tracks for frame " << k;
+    EXPECT_EQ(tracks->header.frame_id, "camera_optical");
+    EXPECT_EQ(tracks->width, 640u);
+    EXPECT_EQ(tracks->height, 480u);
+    const size_t n = tracks->id.size();
+    ASSERT_EQ(tracks->u.size(), n);
+    ASSERT_EQ(tracks->v.size(), n);
+    ASSERT_EQ(tracks->flags.size(), n);
+    ASSERT_EQ(tracks->prev_index.size(), n);
+    ASSERT_EQ(tracks->age.size(), n);
+    if (k == 0) {
+      EXPECT_EQ(n, 50u);
+      EXPECT_TRUE(tracks->searched);
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Point2d uv(tracks->u[i], tracks->v[i]);
+      if (k == 0) first_ids.insert(tracks->id[i]);
+      auto it = texture_of.find(tracks->id[i]);
+      if (it == texture_of.end()) {
+        EXPECT_TRUE(tracks->flags[i] & Tracks::FLAG_NEW);
+        EXPECT_EQ(tracks->prev_index[i], -1);
+        texture_of[tracks->id[i]] = uv - shift;
+        continue;
+      }
+      EXPECT_TRUE(tracks->flags[i] & Tracks::FLAG_TRACKED);
+      EXPECT_GE(tracks->prev_index[i], 0);
+      error_sum += cv::norm(it->second + shift - uv);
+      ++error_count;
+    }
+  }
+  ASSERT_GT(error_count, 500);
+  EXPECT_LT(error_sum / error_count, 0.2);
+  auto last = received_.rbegin()->second;
+  int kept = 0;
+  for (auto id : last->id) kept += first_ids.count(id);
+  EXPECT_GE(kept, 45);
+}
+
+TEST_F(TrackerNodeletTest, AcceptsColourBayerAndSixteenBitImages) {
+  cv::Mat bgr;
+  cv::cvtColor(view({0, 0}), bgr, cv::COLOR_GRAY2BGR);
+  auto tracks = send(makeImage(bgr, "bgr8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  cv::Mat rgba;
+  cv::cvtColor(view({0, 0}), rgba, cv::COLOR_GRAY2RGBA);
+  tracks = send(makeImage(rgba, "rgba8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  cv::Mat wide;
+  view({0, 0}).convertTo(wide, CV_16U, 256.0);
+  tracks = send(makeImage(wide, "mono16", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  tracks = send(makeImage(view({0, 0}), "bayer_rggb8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_GT(tracks->id.size(), 20u);
+}
+
+TEST_F(TrackerNodeletTest, BadImagesAreDroppedAndTrackingGoesOn) {
+  auto good = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(good);
+
+  // Unsupported encoding: dropped, nothing published.
+  cv::Mat floats(480, 640, CV_32FC1, cv::Scalar(0.5));
+  EXPECT_FALSE(send(makeImage(floats, "32FC1", stamp_ += 0.1), 1.0));
+  auto weird = makeImage(view({0, 0}), "mono8", stamp_ += 0.1);
+  weird->encoding = "no_such_encoding";
+  EXPECT_FALSE(send(weird, 1.0));
+
+  // 0x0 image and a buffer shorter than step x height: dropped.
+  auto empty = boost::make_shared<sensor_msgs::Image>();
+  empty->header.stamp = ros::Time(stamp_ += 0.1);
+  empty->encoding = "mono8";
+  EXPECT_FALSE(send(empty, 1.0));
+  auto truncated = makeImage(view({0, 0}), "mono8", stamp_ += 0.1);
+  truncated->data.resize(1000);
+  EXPECT_FALSE(send(truncated, 1.0));
+
+  // A good image after all that: the same points are still tracked.
+  auto after = send(makeImage(view({1, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(after);
+  std::set<uint64_t> before(good->id.begin(), good->id.end());
+  int kept = 0;
+  for (auto id : after->id) kept += before.count(id);
+  EXPECT_GE(kept, 45);
+}
+
+TEST_F(TrackerNodeletTest, BlackTinyAndResizedImages) {
+  auto black = send(makeImage(cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(black);
+  EXPECT_TRUE(black->id.empty());
+
+  auto tiny = send(makeImage(cv::Mat(1, 1, CV_8UC1, cv::Scalar(7)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tiny);
+  EXPECT_TRUE(tiny->id.empty());
+  EXPECT_EQ(tiny->width, 1u);
+
+  cv::Mat small;
+  cv::resize(view({0, 0}), small, {320, 240}, 0, 0, cv::INTER_AREA);
+  auto resized = send(makeImage(small, "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(resized);
+  EXPECT_EQ(resized->width, 320u);
+  ASSERT_FALSE(resized->id.empty());
+  for (auto f : resized->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+}
+
+TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
+  ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1)));
+  auto same = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(same);
+  for (auto f : same->flags) EXPECT_TRUE(f & Tracks::FLAG_TRACKED);
+  auto looped = send(makeImage(view({1, 0}), "mono8", stamp_ - 50.0));
+  ASSERT_TRUE(looped);
+  for (auto f : looped->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+  for (auto p : looped->prev_index) EXPECT_EQ(p, -1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_nodelet");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
