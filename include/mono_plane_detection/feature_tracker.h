@@ -21,7 +21,7 @@ struct TrackerParams {
 
   // Pyramidal Lucas-Kanade (paper II-C).
   int pyramid_levels = 5;      // levels including full resolution (paper: 5)
-  int window_size_px = 21;     // paper: 3; 21 measured best (README, "window size")
+  int window_size_px = 7;      // paper: 3; 7 measured best (README, "LK window size")
   int max_iterations = 30;     // LK termination: iterations per level
   double epsilon_px = 0.01;    // LK termination: step size
   double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
@@ -42,9 +42,9 @@ struct TrackerParams {
   bool mask_existing = true;            // no new corner within min_distance of a live point
   bool reidentify = true;               // give a lost point its old id when it comes back
   int reid_memory_frames = 150;         // how long a lost point can come back
-  int reid_max_hamming = 40;            // of 256 ORB bits
+  int reid_max_hamming = 30;            // of 256 ORB bits
   double reid_ratio = 0.8;              // best / second-best Hamming distance
-  double reid_max_radius_px = 40.0;     // from where the image motion says it went
+  double reid_max_radius_px = 20.0;     // from where the image motion says it went
 };
 
 // One record of the paper's state arrays.
