@@ -199,6 +199,40 @@ TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
   for (auto p : looped->prev_index) EXPECT_EQ(p, -1);
 }
 
+TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
+  sensor_msgs::ImageConstPtr debug;
+  ros::Subscriber sub = nh_.subscribe<sensor_msgs::Image>(
+      "debug_image", 5, [&](const sensor_msgs::ImageConstPtr& m) { debug = m; });
+  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (sub.getNumPublishers() == 0 && ros::WallTime::now() < connect_deadline) {
+    ros::spinOnce();
+    ros::WallDuration(0.02).sleep();
+  }
+  ASSERT_GT(sub.getNumPublishers(), 0u);
+  ros::WallDuration(0.3).sleep();  // let the nodelet see its new subscriber
+  const double stamp = stamp_ += 0.1;
+  ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp)));
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (!debug && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_TRUE(debug);
+  EXPECT_EQ(debug->encoding, "bgr8");
+  EXPECT_EQ(debug->width, 640u);
+  EXPECT_EQ(debug->height, 480u);
+  EXPECT_DOUBLE_EQ(debug->header.stamp.toSec(), ros::Time(stamp).toSec());
+  // Points are drawn in colour on a grey image: some pixels are not grey.
+  const cv::Mat drawn = cv_bridge::toCvShare(debug)->image;
+  int coloured = 0;
+  for (int y = 0; y < drawn.rows; ++y)
+    for (int x = 0; x < drawn.cols; ++x) {
+      const cv::Vec3b p = drawn.at<cv::Vec3b>(y, x);
+      coloured += (p[0] != p[1] || p[1] != p[2]);
+    }
+  EXPECT_GT(coloured, 500);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
