@@ -1,0 +1,50 @@
+// Groups of five points for the coplanarity test (paper IV-A, IV-B): chosen among near
+// neighbours with a matrix of Euclidean distances, no three collinear, and accepted
+// when their five-point invariants agree between the two images.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace mono_plane_detection {
+
+using PointGroup = std::array<int, 5>;  // indices into the point arrays
+
+struct GroupParams {
+  int max_groups = 300;          // coplanar groups kept per image, so the cost stays bounded
+  int groups_per_point = 4;      // fewer points -> fewer groups (max_groups still caps)
+  int max_tries = 6000;          // groups tried at most: with many outliers few pass
+  int max_seeds = 2000;          // seed points with a neighbour list (bounds memory)
+  int neighbours = 10;           // a group is a seed and 4 of its nearest neighbours
+  double min_shape = 0.05;       // triangleShape below this is "collinear" (paper IV-A)
+  double invariant_threshold = 0.1;  // invariantDistance at most this is "coplanar"
+  unsigned seed = 1;             // random choices are deterministic given the seed
+};
+
+// Distances from each seed to every point: the rows of the paper's distance matrix
+// that the groups need (all rows would be N x N memory for nothing).
+cv::Mat distanceRows(const std::vector<cv::Point2d>& points, const std::vector<int>& seeds);
+
+// Up to `count` groups in `points`, each a seed (seeds visited in a random order, round
+// after round) with 4 random points among its `neighbours` nearest, every triple well
+// spread. Deterministic given params.seed.
+std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
+                                    const GroupParams& params, int count);
+
+// Paper IV-A + IV-B: groups tried in buildGroups' order until min(max_groups,
+// groups_per_point * N) pass isCoplanarGroup or max_tries were tried.
+struct CoplanarGroups {
+  std::vector<PointGroup> groups;  // the accepted ones
+  int tried = 0;
+};
+CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
+                                  const std::vector<cv::Point2d>& view2, const GroupParams& params);
+
+// Paper IV-B: the group's invariants in view 1 equal those in view 2 within the
+// threshold. False when either view is degenerate.
+bool isCoplanarGroup(const PointGroup& group, const std::vector<cv::Point2d>& view1,
+                     const std::vector<cv::Point2d>& view2, const GroupParams& params);
+
+}  // namespace mono_plane_detection

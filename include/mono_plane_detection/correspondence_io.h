@@ -1,0 +1,23 @@
+// Reading two-view correspondences: one per line "x1 y1 x2 y2" (pixels, view 1 then
+// view 2), '#' starts a comment, blank lines are skipped.
+#pragma once
+
+#include <istream>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace mono_plane_detection {
+
+struct Correspondences {
+  std::vector<cv::Point2d> view1, view2;
+  std::string error;  // empty when the whole input was read; otherwise names the line
+  int error_line = 0; // 1-based line of the error
+};
+
+// Stops at the first malformed line: not exactly four numbers, a number that is not
+// finite, or trailing text.
+Correspondences readCorrespondences(std::istream& in);
+
+}  // namespace mono_plane_detection
