@@ -7,6 +7,7 @@
 #include <cv_bridge/cv_bridge.h>
 #include <opencv2/imgproc.hpp>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
 #include "mono_plane_detection/Tracks.h"
@@ -197,6 +198,31 @@ TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
   ASSERT_TRUE(looped);
   for (auto f : looped->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
   for (auto p : looped->prev_index) EXPECT_EQ(p, -1);
+}
+
+TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
+  ros::Publisher info_pub = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
+  sensor_msgs::CameraInfo zero;  // all-zero intrinsics
+  zero.width = 640;
+  zero.height = 480;
+  info_pub.publish(zero);
+  ros::WallDuration(0.3).sleep();
+  auto tracks = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  sensor_msgs::CameraInfo other_size;  // valid, but for another image size
+  other_size.width = 1280;
+  other_size.height = 720;
+  other_size.K = {525, 0, 640, 0, 525, 360, 0, 0, 1};
+  other_size.K[2] = std::nan("");
+  info_pub.publish(other_size);
+  other_size.K[2] = 640;
+  info_pub.publish(other_size);
+  ros::WallDuration(0.3).sleep();
+  tracks = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_GE(tracks->id.size(), 45u);
 }
 
 TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {

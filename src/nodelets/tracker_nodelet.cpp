@@ -1,5 +1,6 @@
 // Thin ROS glue around FeatureTracker: image in, Tracks and a debug image out.
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <mutex>
 
@@ -9,6 +10,7 @@
 #include <nodelet/nodelet.h>
 #include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
@@ -133,6 +135,22 @@ class TrackerNodelet : public nodelet::Nodelet {
   void subscribe() {
     image_sub_ = it_->subscribe("image", 5, &TrackerNodelet::imageCallback, this,
                                 image_transport::TransportHints(transport_));
+    info_sub_ = getNodeHandle().subscribe("camera_info", 1, &TrackerNodelet::infoCallback, this);
+  }
+
+  // Optional: tracking works in pixels without it. Kept for its size, checked so that
+  // a broken camera driver is reported here, where the images arrive.
+  void infoCallback(const sensor_msgs::CameraInfoConstPtr& info) {
+    const bool usable = info->K[0] > 0 && info->K[4] > 0 && std::isfinite(info->K[0]) &&
+                        std::isfinite(info->K[4]) && std::isfinite(info->K[2]) &&
+                        std::isfinite(info->K[5]) && info->width > 0 && info->height > 0;
+    if (!usable) {
+      NODELET_WARN_THROTTLE(10.0, "camera_info has unusable intrinsics (fx=%g fy=%g, %ux%u): "
+                            "ignored, tracking goes on in pixels", info->K[0], info->K[4],
+                            info->width, info->height);
+    }
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    info_size_ = usable ? cv::Size(info->width, info->height) : cv::Size();
   }
 
   // Lazy subscription: nobody listens, nothing is tracked. Tracking restarts fresh
@@ -145,6 +163,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       subscribe();
     } else if (!wanted && image_sub_) {
       image_sub_.shutdown();
+      info_sub_.shutdown();
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       tracker_.reset();
       last_stamp_ = ros::Time();
@@ -170,6 +189,11 @@ class TrackerNodelet : public nodelet::Nodelet {
         tracker_.reset();
       }
       last_stamp_ = msg->header.stamp;
+      if (!info_size_.empty() && info_size_ != grey.image->image.size()) {
+        NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but the image is %dx%d",
+                              info_size_.width, info_size_.height, grey.image->image.cols,
+                              grey.image->image.rows);
+      }
       points = tracker_.process(grey.image->image);
       const TrackerFrameStats& stats = tracker_.lastStats();
       searches_ += stats.searched ? 1 : 0;
@@ -194,6 +218,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("points lost (total)", lost_);
     status.add("searches (total)", searches_);
     status.add("images dropped (total)", static_cast<long>(dropped_));
+    status.add("camera_info", info_size_.empty() ? "none or unusable" : "ok");
   }
 
   FeatureTracker tracker_;
@@ -201,6 +226,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   std::string transport_;
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
+  ros::Subscriber info_sub_;
   ros::Publisher tracks_pub_;
   image_transport::Publisher debug_pub_;
 
@@ -211,6 +237,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   long lost_ = 0;
   long searches_ = 0;
   int tracked_now_ = 0;
+  cv::Size info_size_;  // size of the last usable camera_info, empty when none
 
   double min_rate_ = 5.0, max_rate_ = 100.0;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
