@@ -61,3 +61,9 @@ TEST(MatchCorners, EmptyInputs) {
   ASSERT_EQ(m.size(), 1u);
   EXPECT_EQ(m[0], -1);
 }
+
+TEST(ClosestClaimWins, LowestCostPerTargetFirstOnTies) {
+  const auto r = closestClaimWins({0, 0, 1, -1, 1}, {3.0, 1.0, 2.0, 0.0, 2.0}, 2);
+  EXPECT_EQ(r, (std::vector<int>{-1, 0, 1, -1, -1}));
+  EXPECT_TRUE(closestClaimWins({}, {}, 3).empty());
+}

@@ -77,6 +77,12 @@ struct TrackerFrameStats {
 bool shouldSearch(int found_at_last_search, int alive, int frames_since_search,
                   const TrackerParams& params);
 
+// Paper II-D's tie rule, shared by matching and re-identification: claimant c wants
+// target claim[c] (-1: none) at cost[c]; when several want one target the lowest cost
+// wins (the first on equal cost) and the others get -1.
+std::vector<int> closestClaimWins(const std::vector<int>& claim, const std::vector<double>& cost,
+                                  size_t targets);
+
 // Paper II-D: for each corner, the index of the point within radius it matches, or -1.
 // When several corners pick the same point, the closest pair wins.
 std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,

@@ -11,6 +11,9 @@
 namespace mono_plane_detection {
 namespace {
 
+// Sub-pixel corner refinement, for new corners and re-anchored live ones alike.
+const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+
 bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
 }
@@ -169,8 +172,7 @@ void FeatureTracker::search(const cv::Mat& gray) {
                             params_.min_distance_px, mask, params_.block_size);
   }
   if (!corners.empty()) {
-    cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1),
-                     cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01));
+    cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
   }
 
   // Matched corners are the same physical point as a live one: the live point keeps
@@ -211,8 +213,7 @@ void FeatureTracker::reanchor(const cv::Mat& gray) {
   if (current_.empty()) return;
   std::vector<cv::Point2f> refined = positions(current_);
   const int half = params_.reanchor_window_px;
-  cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1),
-                   cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01));
+  cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1), kSubPixCriteria);
   const double max_shift2 = params_.reanchor_max_shift_px * params_.reanchor_max_shift_px;
   for (size_t i = 0; i < current_.size(); ++i) {
     const cv::Point2f d = refined[i] - current_[i].uv;
@@ -237,9 +238,9 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
   if (lost_.empty() || fresh.empty()) return;
 
   const std::vector<cv::Mat> descriptors = orbDescriptors(gray, positions(fresh));
-  // Best lost point per fresh corner, then each lost point goes to its closest claimant.
+  // Each fresh corner claims its best lost point; paper II-D's rule settles conflicts.
   std::vector<int> claim(fresh.size(), -1);
-  std::vector<int> claim_distance(fresh.size(), 0);
+  std::vector<double> claim_distance(fresh.size(), 0.0);
   const double radius2 = params_.reid_max_radius_px * params_.reid_max_radius_px;
   for (size_t f = 0; f < fresh.size(); ++f) {
     if (descriptors[f].empty()) continue;
@@ -265,21 +266,16 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
       claim_distance[f] = best_d;
     }
   }
-  std::vector<int> used(lost_.size(), -1);
-  for (size_t f = 0; f < fresh.size(); ++f) {
-    if (claim[f] < 0) continue;
-    const int owner = used[claim[f]];
-    if (owner < 0 || claim_distance[f] < claim_distance[owner]) used[claim[f]] = static_cast<int>(f);
-  }
+  const std::vector<int> granted = closestClaimWins(claim, claim_distance, lost_.size());
   std::vector<bool> taken(lost_.size(), false);
-  for (size_t l = 0; l < lost_.size(); ++l) {
-    if (used[l] < 0) continue;
-    TrackedPoint& p = fresh[used[l]];
-    p.id = lost_[l].id;
-    p.age = lost_[l].age;
-    p.is_reidentified = true;
+  for (size_t f = 0; f < fresh.size(); ++f) {
+    if (granted[f] < 0) continue;
+    const LostPoint& l = lost_[granted[f]];
+    fresh[f].id = l.id;
+    fresh[f].age = l.age;
+    fresh[f].is_reidentified = true;
     ++stats_.reidentified;
-    taken[l] = true;
+    taken[granted[f]] = true;
   }
   std::vector<LostPoint> kept;
   for (size_t l = 0; l < lost_.size(); ++l) {

@@ -2,7 +2,6 @@
 // image work so they can be tested on hand-made cases.
 #include "mono_plane_detection/feature_tracker.h"
 
-#include <limits>
 
 namespace mono_plane_detection {
 
@@ -17,37 +16,38 @@ bool shouldSearch(int found_at_last_search, int alive, int frames_since_search,
   return lost >= params.redetect_lost_fraction * found_at_last_search - 1e-9;
 }
 
+std::vector<int> closestClaimWins(const std::vector<int>& claim, const std::vector<double>& cost,
+                                  size_t targets) {
+  std::vector<int> winner(targets, -1);
+  for (size_t c = 0; c < claim.size(); ++c) {
+    if (claim[c] < 0) continue;
+    int& w = winner[claim[c]];
+    if (w < 0 || cost[c] < cost[w]) w = static_cast<int>(c);
+  }
+  std::vector<int> result(claim.size(), -1);
+  for (size_t c = 0; c < claim.size(); ++c) {
+    if (claim[c] >= 0 && winner[claim[c]] == static_cast<int>(c)) result[c] = claim[c];
+  }
+  return result;
+}
+
 std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,
                                       const std::vector<cv::Point2f>& points,
                                       double radius_px) {
-  std::vector<int> match(corners.size(), -1);
-  // For every point, the closest corner that picked it wins.
-  std::vector<int> winner(points.size(), -1);
-  std::vector<double> winner_distance(points.size(), std::numeric_limits<double>::max());
+  std::vector<int> nearest(corners.size(), -1);
+  std::vector<double> distance2(corners.size(), 0.0);
   const double radius2 = radius_px * radius_px;
   for (size_t c = 0; c < corners.size(); ++c) {
-    int best = -1;
-    double best_d2 = 0.0;
     for (size_t p = 0; p < points.size(); ++p) {
       const cv::Point2f d = corners[c] - points[p];
       const double d2 = static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y;
-      if (d2 > radius2) continue;
-      if (best < 0 || d2 < best_d2) {
-        best = static_cast<int>(p);
-        best_d2 = d2;
+      if (d2 <= radius2 && (nearest[c] < 0 || d2 < distance2[c])) {
+        nearest[c] = static_cast<int>(p);
+        distance2[c] = d2;
       }
     }
-    if (best < 0) continue;
-    match[c] = best;
-    if (best_d2 < winner_distance[best]) {
-      winner[best] = static_cast<int>(c);
-      winner_distance[best] = best_d2;
-    }
   }
-  for (size_t c = 0; c < corners.size(); ++c) {
-    if (match[c] >= 0 && winner[match[c]] != static_cast<int>(c)) match[c] = -1;
-  }
-  return match;
+  return closestClaimWins(nearest, distance2, points.size());
 }
 
 }  // namespace mono_plane_detection
