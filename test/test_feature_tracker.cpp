@@ -47,10 +47,10 @@ TEST(FeatureTracker, EasyMotionTrackedBelowFifthOfPixel) {
   FeatureTracker tracker;
   const auto run = runOnViews(tracker, texture(),
                               translations(60, kCentred, {1.3, -0.7}, 0.002), kView);
-  ASSERT_GT(run.errors.size(), 1000u);
-  EXPECT_LT(run.meanError(), 0.2);
+  ASSERT_GT(run.score.errors().size(), 1000u);
+  EXPECT_LT(run.score.meanError(), 0.2);
   // A few points on edges slide along them; the forward-backward check cannot see that.
-  EXPECT_LT(run.percentileError(0.99), 1.0);
+  EXPECT_LT(percentile(run.score.errors(), 0.99), 1.0);
 }
 
 TEST(FeatureTracker, PrevIndexPointsToSamePointInPreviousState) {
@@ -79,7 +79,7 @@ TEST(FeatureTracker, IdsStableOverHundredFrames) {
   for (auto id : first) kept += last.count(id);
   EXPECT_GE(kept, 40);  // of 50
   // Every id still names its own physical point.
-  EXPECT_LT(run.maxError(), 2.0);
+  EXPECT_LT(run.score.maxError(), 2.0);
 }
 
 TEST(FeatureTracker, IdsIncreaseAndAreNeverReused) {
@@ -202,7 +202,7 @@ int returnedWithOldId(bool reidentify) {
   EXPECT_GE(left, 40);
   // Every id, re-identified or not, is still on the texture pixel it was born on.
   for (const auto& p : run.states.back()) {
-    const cv::Point2d truth = transfer(hs.back(), run.texture_of.at(p.id));
+    const cv::Point2d truth = transfer(hs.back(), run.score.texturePixel(p.id));
     EXPECT_LT(cv::norm(truth - cv::Point2d(p.uv)), 2.0) << "id " << p.id << " on a wrong point";
   }
   return back;

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -16,6 +15,7 @@
 
 #include "mono_plane_detection/feature_tracker.h"
 #include "mono_plane_detection/synthetic_views.h"
+#include "mono_plane_detection/track_scorer.h"
 
 using namespace mono_plane_detection;
 
@@ -50,18 +50,11 @@ struct Result {
   double mean_error = 0, p95_error = 0, survival = 0, mean_ms = 0, p95_ms = 0;
 };
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * v.size()));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
-}
-
 Result run(const TrackerParams& params, const Motion& motion, const cv::Mat& texture,
            const cv::Size& view_size, int frames) {
   FeatureTracker tracker(params);
-  std::map<std::uint64_t, cv::Point2d> texture_of;
-  std::vector<double> errors, times;
+  TrackScorer score;
+  std::vector<double> times;
   double tracked = 0, followed = 0;
   for (int k = 0; k < frames; ++k) {
     const cv::Matx33d H = motion.at(k);
@@ -75,19 +68,11 @@ Result run(const TrackerParams& params, const Motion& motion, const cv::Mat& tex
     times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     followed += tracker.previous().size();
     tracked += tracker.lastStats().tracked;
-    const cv::Matx33d Hinv = H.inv();
-    for (const auto& p : points) {
-      auto it = texture_of.find(p.id);
-      if (it == texture_of.end()) {
-        texture_of[p.id] = transfer(Hinv, cv::Point2d(p.uv));
-      } else if (p.is_tracked) {
-        errors.push_back(cv::norm(transfer(H, it->second) - cv::Point2d(p.uv)));
-      }
-    }
+    score.observe(points, H);
   }
   Result r;
-  for (double e : errors) r.mean_error += e / std::max<size_t>(1, errors.size());
-  r.p95_error = percentile(errors, 0.95);
+  r.mean_error = score.meanError();
+  r.p95_error = percentile(score.errors(), 0.95);
   r.survival = followed > 0 ? tracked / followed : 0.0;
   for (double t : times) r.mean_ms += t / times.size();
   r.p95_ms = percentile(times, 0.95);
