@@ -29,9 +29,14 @@ struct Vote {
 };
 
 // Paper IV-C over the points with active[i] (all when active is empty).
+// vote_bounds (optional, in/out, one per homography, start at INT_MAX): the counts of an
+// earlier vote over a superset of the active points. Votes can only fall as points
+// leave, so a homography whose bound cannot beat the best so far is not counted again;
+// the result is the same as without bounds.
 Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
-                  const std::vector<bool>& active, double threshold_px);
+                  const std::vector<bool>& active, double threshold_px,
+                  std::vector<int>* vote_bounds = nullptr);
 
 // Points (among active ones, all when empty) whose transfer error under H is below
 // the threshold.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "mono_plane_detection/homography_fit.h"
@@ -94,17 +95,43 @@ std::vector<int> assignPoints(const std::vector<Plane>& planes, const std::vecto
   return labels;
 }
 
+// assignPoints, then drops the least supported plane while it has fewer than
+// min_plane_support points, assigning again each time. Returns each plane's points.
+std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
+                                                  const std::vector<cv::Point2d>& view1,
+                                                  const std::vector<cv::Point2d>& view2,
+                                                  const PlaneParams& params) {
+  for (;;) {
+    const std::vector<int> labels = assignPoints(planes, view1, view2, params.vote_threshold_px);
+    std::vector<std::vector<int>> members(planes.size());
+    for (size_t i = 0; i < labels.size(); ++i) {
+      if (labels[i] > 0) members[labels[i] - 1].push_back(static_cast<int>(i));
+    }
+    const auto smallest = std::min_element(
+        members.begin(), members.end(),
+        [](const std::vector<int>& a, const std::vector<int>& b) { return a.size() < b.size(); });
+    if (smallest == members.end() || static_cast<int>(smallest->size()) >= params.min_plane_support) {
+      return members;
+    }
+    planes.erase(planes.begin() + (smallest - members.begin()));
+  }
+}
+
 }  // namespace
 
 Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
-                  const std::vector<bool>& active, double threshold_px) {
+                  const std::vector<bool>& active, double threshold_px,
+                  std::vector<int>* vote_bounds) {
   Vote vote;
   for (size_t h = 0; h < homographies.size(); ++h) {
+    // A bound equal to the best can at most tie, and ties go to the earlier one.
+    if (vote_bounds && (*vote_bounds)[h] <= vote.votes) continue;
     int votes = 0;
     for (size_t i = 0; i < view1.size(); ++i) {
       if (isActive(active, i) && transferError(homographies[h], view1[i], view2[i]) < threshold_px) ++votes;
     }
+    if (vote_bounds) (*vote_bounds)[h] = votes;
     if (votes > vote.votes) {  // strictly more: the first keeps a tie
       vote.votes = votes;
       vote.winner = static_cast<int>(h);
@@ -167,13 +194,14 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
 
   // Paper IV-C repeated: the winner becomes a plane, its points leave the vote.
   std::vector<Plane> planes;
-  while (static_cast<int>(planes.size()) < params.max_planes && !candidates.empty()) {
-    Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px);
+  std::vector<int> bounds(candidates.size(), std::numeric_limits<int>::max());
+  while (static_cast<int>(planes.size()) < params.max_planes) {
+    Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px, &bounds);
     if (vote.winner < 0 || vote.votes < params.min_plane_support) break;
     Plane plane;
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
-    candidates.erase(candidates.begin() + vote.winner);
+    bounds[vote.winner] = 0;  // used: never votes again
     if (!refitPlane(plane.H, plane.inliers, view1, view2, active, params) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
@@ -183,39 +211,24 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
   }
   mergeSamePlanes(planes, view1, view2, params);
 
-  // Final assignment, one refit on what each plane got, then by support.
-  std::vector<int> labels = assignPoints(planes, view1, view2, params.vote_threshold_px);
-  std::vector<Plane> kept;
+  // Every point to the plane that explains it best; planes left with too few points
+  // go (their points may suit another); each plane is refitted on what it got.
+  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params);
   for (size_t k = 0; k < planes.size(); ++k) {
-    std::vector<int> mine;
-    for (size_t i = 0; i < labels.size(); ++i) {
-      if (labels[i] == static_cast<int>(k) + 1) mine.push_back(static_cast<int>(i));
-    }
-    if (static_cast<int>(mine.size()) < params.min_plane_support) continue;
-    if (auto H = fitHomography(select(view1, mine), select(view2, mine))) planes[k].H = *H;
-    kept.push_back(planes[k]);
+    if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]))) planes[k].H = *H;
   }
-  labels = assignPoints(kept, view1, view2, params.vote_threshold_px);
-  for (auto& p : kept) p.inliers.clear();
-  for (size_t i = 0; i < labels.size(); ++i) {
-    if (labels[i] > 0) kept[labels[i] - 1].inliers.push_back(static_cast<int>(i));
-  }
-  kept.erase(std::remove_if(kept.begin(), kept.end(),
-                            [&](const Plane& p) {
-                              return static_cast<int>(p.inliers.size()) < params.min_plane_support;
-                            }),
-             kept.end());
-  std::stable_sort(kept.begin(), kept.end(), [](const Plane& a, const Plane& b) {
+  members = keepSupportedPlanes(planes, view1, view2, params);
+  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+  std::stable_sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) {
     return a.inliers.size() > b.inliers.size();
   });
-  out.planes = std::move(kept);
-  out.labels.assign(view1.size(), 0);
-  for (size_t k = 0; k < out.planes.size(); ++k) {
-    Plane& p = out.planes[k];
+  for (size_t k = 0; k < planes.size(); ++k) {
+    Plane& p = planes[k];
     for (int i : p.inliers) out.labels[i] = static_cast<int>(k) + 1;
     p.rms_error_px = rmsError(p.H, p.inliers, view1, view2);
     p.score = static_cast<double>(p.inliers.size()) / view1.size();
   }
+  out.planes = std::move(planes);
   return out;
 }
 
