@@ -92,13 +92,15 @@ TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {
 }
 
 // Multi-plane recovery over a grid of synthetic scenes: 2-4 planes, 0.5-1 px noise,
-// 0-60 % outliers, three seeds each. The vote threshold follows the noise (4 sigma, at
-// least the paper's 2 px): with sigma = 1 px only 64 % of true inliers are within 2 px.
-// Measured: 2-3 planes with <= 30 % outliers at most 5.6 % error, every plane found;
-// over the whole grid 9.5 % mean (4 narrow planes and 60 % outliers split or merge
-// planes: a known limitation, see README).
+// 0-60 % outliers, three seeds each, judged against the oracle that knows the true
+// homographies (bestPossibleLabels: 0.7-5.4 % here, the error noise makes unavoidable).
+// The vote threshold follows the noise (4 sigma, at least the paper's 2 px): with
+// sigma = 1 px only 64 % of true inliers are within 2 px.
+// Measured: 2-3 planes with <= 30 % outliers at most 5.0 points above the oracle, every
+// plane found; over the whole grid 3.8 points above it on average (4 planes at 1 px
+// noise and 60 % outliers still lose or split a plane: see README).
 TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
-  double sum = 0, worst_easy = 0;
+  double excess_sum = 0, worst_easy = 0;
   int runs = 0;
   for (int planes = 2; planes <= 4; ++planes) {
     for (double outliers : {0.0, 0.3, 0.6}) {
@@ -112,21 +114,24 @@ TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
         PlaneParams params;
         params.vote_threshold_px = std::max(2.0, 4.0 * sp.noise_px);
         const auto result = segmentPlanes(scene.view1, scene.view2, params);
-        const double e = misclassificationError(scene.labels, result.labels);
+        const double excess =
+            misclassificationError(scene.labels, result.labels) -
+            misclassificationError(scene.labels, bestPossibleLabels(scene, params.vote_threshold_px));
         if (planes <= 3 && outliers <= 0.3) {
-          EXPECT_LT(e, 0.08) << planes << " planes, " << outliers << " outliers, seed " << seed;
+          EXPECT_LT(excess, 0.07) << planes << " planes, " << outliers << " outliers, seed " << seed;
           EXPECT_EQ(static_cast<int>(result.planes.size()), planes)
               << planes << " planes, " << outliers << " outliers, seed " << seed;
-          worst_easy = std::max(worst_easy, e);
+          worst_easy = std::max(worst_easy, excess);
         }
-        sum += e;
+        excess_sum += excess;
         ++runs;
       }
     }
   }
-  std::printf("synthetic multi-plane: mean error %.2f %% over %d scenes, worst with 2-3 planes "
-              "and <= 30 %% outliers %.2f %%\n", 100 * sum / runs, runs, 100 * worst_easy);
-  EXPECT_LT(sum / runs, 0.12);
+  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d scenes, "
+              "worst with 2-3 planes and <= 30 %% outliers %.2f\n",
+              100 * excess_sum / runs, runs, 100 * worst_easy);
+  EXPECT_LT(excess_sum / runs, 0.05);
 }
 
 TEST(SegmentPlanes, PlanesAreSortedAndConsistentWithLabels) {

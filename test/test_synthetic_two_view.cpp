@@ -43,3 +43,18 @@ TEST(MisclassificationError, BestMatchingOfLabels) {
   EXPECT_DOUBLE_EQ(misclassificationError({0, 0, 1, 1}, {1, 1, 0, 0}), 1.0);  // 0 only matches 0
   EXPECT_DOUBLE_EQ(misclassificationError({1, 1, 1, 1}, {1, 1, 2, 3}), 0.5);
 }
+
+TEST(BestPossibleLabels, ExactDataIsPerfectNoiseIsNot) {
+  TwoViewSceneParams p;
+  p.noise_px = 0.0;
+  p.outlier_fraction = 0.0;
+  auto scene = makeTwoViewScene(p);
+  EXPECT_EQ(misclassificationError(scene.labels, bestPossibleLabels(scene, 2.0)), 0.0);
+  p.noise_px = 1.0;
+  scene = makeTwoViewScene(p);
+  const double noisy = misclassificationError(scene.labels, bestPossibleLabels(scene, 4.0));
+  EXPECT_GT(noisy, 0.0);   // near the planes' intersections noise decides
+  EXPECT_LT(noisy, 0.10);
+  // A threshold far below the noise rejects most true points.
+  EXPECT_GT(misclassificationError(scene.labels, bestPossibleLabels(scene, 0.5)), 0.5);
+}

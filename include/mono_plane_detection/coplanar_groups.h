@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <random>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -27,9 +28,30 @@ struct GroupParams {
 // that the groups need (all rows would be N x N memory for nothing).
 cv::Mat distanceRows(const std::vector<cv::Point2d>& points, const std::vector<int>& seeds);
 
-// Up to `count` groups in `points`, each a seed (seeds visited in a random order, round
-// after round) with 4 random points among its `neighbours` nearest, every triple well
-// spread. Deterministic given params.seed.
+// Draws groups on demand: a seed (seeds visited in a random order, round after round)
+// with 4 random points among its `neighbours` nearest, every triple well spread. A
+// seed's row of the distance matrix is computed on its first visit only, so the cost
+// follows the groups drawn, not N x N. Deterministic given params.seed.
+class GroupSampler {
+ public:
+  GroupSampler(const std::vector<cv::Point2d>& points, const GroupParams& params);
+  // The next well-spread group; false when none is left to draw (fewer than 5
+  // points, or 4 draws per requested group failed in a row of degenerate neighbours).
+  bool next(PointGroup& group);
+
+ private:
+  const std::vector<int>& neighboursOf(size_t seed_slot);
+
+  const std::vector<cv::Point2d>& points_;
+  GroupParams params_;
+  std::mt19937 rng_;
+  std::vector<int> seeds_;
+  std::vector<std::vector<int>> near_;  // per seed slot, empty until visited
+  long draws_ = 0;
+  long failures_in_a_row_ = 0;
+};
+
+// Up to `count` groups from a GroupSampler.
 std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
                                     const GroupParams& params, int count);
 

@@ -19,7 +19,7 @@ struct PlaneParams {
   int max_planes = 8;              // stop after this many
   int refit_iterations = 4;        // refit on inliers / recompute inliers rounds
   bool robust_refit = true;        // Cauchy re-weighting in the refit
-  double merge_fraction = 0.9;     // merge when one fit on both explains this share of each
+  double merge_fraction = 0.8;     // merge when one refit on both explains this share of each
 };
 
 struct Vote {

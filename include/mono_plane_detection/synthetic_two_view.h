@@ -31,6 +31,11 @@ struct TwoViewScene {
 
 TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params);
 
+// The labels an oracle gives that knows the true homographies: each point to the plane
+// whose homography transfers it best, 0 beyond threshold_px. Its misclassification is
+// what noise makes unavoidable (points near where two planes meet).
+std::vector<int> bestPossibleLabels(const TwoViewScene& scene, double threshold_px);
+
 // Share of points whose label is wrong after the best one-to-one matching of found
 // planes to true planes (0 is matched to 0), as in the AdelaideRMF literature.
 double misclassificationError(const std::vector<int>& truth, const std::vector<int>& found);

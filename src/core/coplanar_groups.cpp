@@ -20,50 +20,68 @@ cv::Mat distanceRows(const std::vector<cv::Point2d>& points, const std::vector<i
   for (size_t s = 0; s < seeds.size(); ++s) {
     double* row = rows.ptr<double>(static_cast<int>(s));
     const cv::Point2d& a = points[seeds[s]];
-    for (size_t j = 0; j < points.size(); ++j) row[j] = std::hypot(points[j].x - a.x, points[j].y - a.y);
+    for (size_t j = 0; j < points.size(); ++j) {
+      const double dx = points[j].x - a.x, dy = points[j].y - a.y;
+      row[j] = std::sqrt(dx * dx + dy * dy);
+    }
   }
   return rows;
 }
 
-std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
-                                    const GroupParams& params, int count) {
-  const int n = static_cast<int>(points.size());
-  std::vector<PointGroup> groups;
-  if (n < 5 || count <= 0) return groups;
-  const int neighbours = std::min(std::max(params.neighbours, 4), n - 1);
+GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupParams& params)
+    : points_(points), params_(params), rng_(params.seed) {
+  if (points.size() < 5) return;
+  seeds_.resize(points.size());
+  std::iota(seeds_.begin(), seeds_.end(), 0);
+  std::shuffle(seeds_.begin(), seeds_.end(), rng_);
+  seeds_.resize(std::min(seeds_.size(), static_cast<size_t>(std::max(1, params.max_seeds))));
+  near_.resize(seeds_.size());
+}
 
-  std::mt19937 rng(params.seed);
-  std::vector<int> seeds(n);
-  std::iota(seeds.begin(), seeds.end(), 0);
-  std::shuffle(seeds.begin(), seeds.end(), rng);
-  seeds.resize(std::min(n, std::max(1, params.max_seeds)));
-
-  // Each seed's nearest points, from its row of the distance matrix.
-  const cv::Mat distances = distanceRows(points, seeds);
-  std::vector<std::vector<int>> near(seeds.size());
+const std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
+  std::vector<int>& near = near_[slot];
+  if (!near.empty()) return near;
+  const int n = static_cast<int>(points_.size());
+  const int k = std::min(std::max(params_.neighbours, 4), n - 1);
+  const cv::Mat row = distanceRows(points_, {seeds_[slot]});
+  const double* d = row.ptr<double>(0);
   std::vector<int> order(n);
-  for (size_t s = 0; s < seeds.size(); ++s) {
-    const double* row = distances.ptr<double>(static_cast<int>(s));
-    std::iota(order.begin(), order.end(), 0);
-    std::nth_element(order.begin(), order.begin() + neighbours, order.end(),
-                     [row](int a, int b) { return row[a] < row[b]; });
-    for (int k = 0; k <= neighbours; ++k) {
-      if (order[k] != seeds[s] && static_cast<int>(near[s].size()) < neighbours) near[s].push_back(order[k]);
-    }
+  std::iota(order.begin(), order.end(), 0);
+  std::nth_element(order.begin(), order.begin() + k, order.end(),
+                   [d](int a, int b) { return d[a] < d[b]; });
+  for (int i = 0; i <= k && static_cast<int>(near.size()) < k; ++i) {
+    if (order[i] != seeds_[slot]) near.push_back(order[i]);
   }
+  return near;
+}
 
-  // Round-robin over the seeds; a degenerate draw costs a try, not a group.
-  const long max_draws = 4L * count;
-  for (long draw = 0; draw < max_draws && static_cast<int>(groups.size()) < count; ++draw) {
-    const size_t s = static_cast<size_t>(draw % static_cast<long>(seeds.size()));
-    std::vector<int>& candidates = near[s];
+bool GroupSampler::next(PointGroup& group) {
+  if (seeds_.empty()) return false;
+  // Round-robin over the seeds; a run of degenerate draws this long means the points
+  // are (nearly) all collinear, and drawing on would never end.
+  const long give_up = 4L * static_cast<long>(seeds_.size()) + 64;
+  while (failures_in_a_row_ < give_up) {
+    const size_t slot = static_cast<size_t>(draws_++ % static_cast<long>(seeds_.size()));
+    std::vector<int> candidates = neighboursOf(slot);
     for (int k = 0; k < 4; ++k) {  // partial Fisher-Yates: 4 distinct neighbours
       std::uniform_int_distribution<int> pick_one(k, static_cast<int>(candidates.size()) - 1);
-      std::swap(candidates[k], candidates[pick_one(rng)]);
+      std::swap(candidates[k], candidates[pick_one(rng_)]);
     }
-    const PointGroup g{seeds[s], candidates[0], candidates[1], candidates[2], candidates[3]};
-    if (wellSpread(pick(g, points), params.min_shape)) groups.push_back(g);
+    group = {seeds_[slot], candidates[0], candidates[1], candidates[2], candidates[3]};
+    if (wellSpread(pick(group, points_), params_.min_shape)) {
+      failures_in_a_row_ = 0;
+      return true;
+    }
+    ++failures_in_a_row_;
   }
+  return false;
+}
+
+std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
+                                    const GroupParams& params, int count) {
+  std::vector<PointGroup> groups;
+  GroupSampler sampler(points, params);
+  for (PointGroup g; static_cast<int>(groups.size()) < count && sampler.next(g);) groups.push_back(g);
   return groups;
 }
 
@@ -72,8 +90,9 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
   CoplanarGroups out;
   const long wanted = std::min<long>(params.max_groups,
                                      static_cast<long>(params.groups_per_point) * view2.size());
-  for (const PointGroup& g : buildGroups(view2, params, params.max_tries)) {
-    if (static_cast<long>(out.groups.size()) >= wanted) break;
+  GroupSampler sampler(view2, params);
+  PointGroup g;
+  while (static_cast<long>(out.groups.size()) < wanted && out.tried < params.max_tries && sampler.next(g)) {
     ++out.tried;
     if (isCoplanarGroup(g, view1, view2, params)) out.groups.push_back(g);
   }

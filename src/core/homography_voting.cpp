@@ -57,8 +57,13 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
       for (size_t j = i + 1; j < planes.size() && !merged; ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        const auto H = fitHomography(select(view1, both), select(view2, both));
+        // Judged after the same robust refit a plane gets, on the union's points only.
+        auto H = fitHomography(select(view1, both), select(view2, both));
         if (!H) continue;
+        std::vector<bool> in_union(view1.size(), false);
+        for (int k : both) in_union[k] = true;
+        std::vector<int> union_inliers = both;
+        if (!refitPlane(*H, union_inliers, view1, view2, in_union, params)) continue;
         auto explained = [&](const std::vector<int>& idx) {
           int n = 0;
           for (int k : idx) n += transferError(*H, view1[k], view2[k]) < params.vote_threshold_px;
@@ -115,6 +120,24 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
     }
     planes.erase(planes.begin() + (smallest - members.begin()));
   }
+}
+
+// Alternates assigning every point to its best plane and refitting each plane on its
+// points until the labels stop changing: pieces found early, which hold a few points of
+// a neighbouring plane, give those points back. Leaves planes[k].inliers set.
+void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
+                      const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
+  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params);
+  for (int round = 0; round < params.refit_iterations; ++round) {
+    for (size_t k = 0; k < planes.size(); ++k) {
+      if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]))) planes[k].H = *H;
+    }
+    std::vector<std::vector<int>> next = keepSupportedPlanes(planes, view1, view2, params);
+    const bool stable = next == members;
+    members = std::move(next);
+    if (stable) break;
+  }
+  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
 }
 
 }  // namespace
@@ -209,16 +232,9 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
     for (int i : plane.inliers) active[i] = false;
     planes.push_back(std::move(plane));
   }
+  refineAssignment(planes, view1, view2, params);
   mergeSamePlanes(planes, view1, view2, params);
-
-  // Every point to the plane that explains it best; planes left with too few points
-  // go (their points may suit another); each plane is refitted on what it got.
-  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params);
-  for (size_t k = 0; k < planes.size(); ++k) {
-    if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]))) planes[k].H = *H;
-  }
-  members = keepSupportedPlanes(planes, view1, view2, params);
-  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+  refineAssignment(planes, view1, view2, params);
   std::stable_sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) {
     return a.inliers.size() > b.inliers.size();
   });

@@ -7,6 +7,8 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/homography_fit.h"
+
 namespace mono_plane_detection {
 namespace {
 
@@ -107,6 +109,21 @@ TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params) {
     shuffled.labels.push_back(scene.labels[i]);
   }
   return shuffled;
+}
+
+std::vector<int> bestPossibleLabels(const TwoViewScene& scene, double threshold_px) {
+  std::vector<int> labels(scene.view1.size(), 0);
+  for (size_t i = 0; i < labels.size(); ++i) {
+    double best = threshold_px;
+    for (size_t k = 0; k < scene.homographies.size(); ++k) {
+      const double e = transferError(scene.homographies[k], scene.view1[i], scene.view2[i]);
+      if (e < best) {
+        best = e;
+        labels[i] = static_cast<int>(k) + 1;
+      }
+    }
+  }
+  return labels;
 }
 
 double misclassificationError(const std::vector<int>& truth, const std::vector<int>& found) {
