@@ -30,15 +30,28 @@ TEST(CoplanarGroups, GroupsAreNearWellSpreadDistinctAndDeterministic) {
     std::array<cv::Point2d, 5> pts;
     for (int k = 0; k < 5; ++k) pts[k] = scene.view2[g[k]];
     EXPECT_TRUE(wellSpread(pts, params.min_shape));
-    // Every member is among the seed's 10 nearest: closer than the 11th point.
+    // Every member is among the seed's 10 nearest points at 30 px or more.
     std::vector<double> d;
-    for (const auto& q : scene.view2) d.push_back(cv::norm(q - pts[0]));
-    std::nth_element(d.begin(), d.begin() + 10, d.end());
-    for (int k = 1; k < 5; ++k) EXPECT_LE(cv::norm(pts[k] - pts[0]), d[10] + 1e-9);
+    for (const auto& q : scene.view2) {
+      const double r = cv::norm(q - pts[0]);
+      if (r >= params.min_neighbour_distance_px) d.push_back(r);
+    }
+    std::nth_element(d.begin(), d.begin() + 9, d.end());
+    for (int k = 1; k < 5; ++k) {
+      EXPECT_GE(cv::norm(pts[k] - pts[0]), params.min_neighbour_distance_px);
+      EXPECT_LE(cv::norm(pts[k] - pts[0]), d[9] + 1e-9);
+    }
   }
   EXPECT_EQ(buildGroups(scene.view2, params, 200), groups);
   params.seed = 2;
   EXPECT_NE(buildGroups(scene.view2, params, 200), groups);
+}
+
+TEST(CoplanarGroups, TightClustersFallBackToTheNearestPoints) {
+  // All points within 20 px: none is 30 px from a seed, the nearest are used instead.
+  const std::vector<cv::Point2d> tight{{0, 0}, {10, 1}, {9, 12}, {-1, 8}, {2, 19}, {15, 15}};
+  const auto groups = buildGroups(tight, GroupParams(), 5);
+  EXPECT_EQ(groups.size(), 5u);
 }
 
 TEST(CoplanarGroups, FewerThanFivePointsGiveNoGroup) {

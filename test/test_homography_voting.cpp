@@ -92,46 +92,52 @@ TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {
 }
 
 // Multi-plane recovery over a grid of synthetic scenes: 2-4 planes, 0.5-1 px noise,
-// 0-60 % outliers, three seeds each, judged against the oracle that knows the true
-// homographies (bestPossibleLabels: 0.7-5.4 % here, the error noise makes unavoidable).
-// The vote threshold follows the noise (4 sigma, at least the paper's 2 px): with
-// sigma = 1 px only 64 % of true inliers are within 2 px.
-// Measured: 2-3 planes with <= 30 % outliers at most 5.0 points above the oracle, every
-// plane found; over the whole grid 3.8 points above it on average (4 planes at 1 px
-// noise and 60 % outliers still lose or split a plane: see README).
+// 0-60 % outliers, three scenes each, each run with three group seeds (the method is
+// randomized: a bound on one draw would test luck). Judged against the oracle that
+// knows the true homographies (bestPossibleLabels: 0.7-5.4 % here, the error noise makes
+// unavoidable). The vote threshold follows the noise (4 sigma, at least the paper's
+// 2 px): with sigma = 1 px only 64 % of true inliers are within 2 px.
+// Measured: on 2-3 planes with <= 30 % outliers every run finds every plane and 2 of 36
+// runs are more than 7 points above the oracle (a homography bridging two adjacent
+// planes); over the whole grid 3.1 points above it on average.
 TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
-  double excess_sum = 0, worst_easy = 0;
-  int runs = 0;
-  for (int planes = 2; planes <= 4; ++planes) {
-    for (double outliers : {0.0, 0.3, 0.6}) {
-      for (unsigned seed = 1; seed <= 3; ++seed) {
-        TwoViewSceneParams sp;
-        sp.planes = planes;
-        sp.outlier_fraction = outliers;
-        sp.noise_px = 0.5 + 0.25 * (seed - 1);
-        sp.seed = seed * 17 + planes;
-        const auto scene = makeTwoViewScene(sp);
-        PlaneParams params;
-        params.vote_threshold_px = std::max(2.0, 4.0 * sp.noise_px);
-        const auto result = segmentPlanes(scene.view1, scene.view2, params);
-        const double excess =
-            misclassificationError(scene.labels, result.labels) -
-            misclassificationError(scene.labels, bestPossibleLabels(scene, params.vote_threshold_px));
-        if (planes <= 3 && outliers <= 0.3) {
-          EXPECT_LT(excess, 0.07) << planes << " planes, " << outliers << " outliers, seed " << seed;
-          EXPECT_EQ(static_cast<int>(result.planes.size()), planes)
-              << planes << " planes, " << outliers << " outliers, seed " << seed;
-          worst_easy = std::max(worst_easy, excess);
+  double excess_sum = 0;
+  int runs = 0, easy_runs = 0, easy_far_off = 0;
+  for (unsigned group_seed = 1; group_seed <= 3; ++group_seed) {
+    for (int planes = 2; planes <= 4; ++planes) {
+      for (double outliers : {0.0, 0.3, 0.6}) {
+        for (unsigned seed = 1; seed <= 3; ++seed) {
+          TwoViewSceneParams sp;
+          sp.planes = planes;
+          sp.outlier_fraction = outliers;
+          sp.noise_px = 0.5 + 0.25 * (seed - 1);
+          sp.seed = seed * 17 + planes;
+          const auto scene = makeTwoViewScene(sp);
+          PlaneParams params;
+          params.vote_threshold_px = std::max(2.0, 4.0 * sp.noise_px);
+          params.groups.seed = group_seed;
+          const auto result = segmentPlanes(scene.view1, scene.view2, params);
+          const double excess =
+              misclassificationError(scene.labels, result.labels) -
+              misclassificationError(scene.labels, bestPossibleLabels(scene, params.vote_threshold_px));
+          if (planes <= 3 && outliers <= 0.3) {
+            EXPECT_EQ(static_cast<int>(result.planes.size()), planes)
+                << planes << " planes, " << outliers << " outliers, seed " << seed
+                << ", group seed " << group_seed;
+            ++easy_runs;
+            easy_far_off += excess > 0.07;
+          }
+          excess_sum += excess;
+          ++runs;
         }
-        excess_sum += excess;
-        ++runs;
       }
     }
   }
-  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d scenes, "
-              "worst with 2-3 planes and <= 30 %% outliers %.2f\n",
-              100 * excess_sum / runs, runs, 100 * worst_easy);
-  EXPECT_LT(excess_sum / runs, 0.05);
+  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d runs; "
+              "%d of %d runs with 2-3 planes and <= 30 %% outliers more than 7 points above\n",
+              100 * excess_sum / runs, runs, easy_far_off, easy_runs);
+  EXPECT_LE(easy_far_off, 3);
+  EXPECT_LT(excess_sum / runs, 0.045);
 }
 
 TEST(SegmentPlanes, PlanesAreSortedAndConsistentWithLabels) {

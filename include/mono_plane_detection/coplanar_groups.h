@@ -17,8 +17,12 @@ struct GroupParams {
   int max_groups = 300;          // coplanar groups kept per image, so the cost stays bounded
   int groups_per_point = 4;      // fewer points -> fewer groups (max_groups still caps)
   int max_tries = 6000;          // groups tried at most: with many outliers few pass
+  int tries_per_point = 40;      // fewer points -> fewer tries (max_tries still caps)
   int max_seeds = 2000;          // seed points with a neighbour list (bounds memory)
   int neighbours = 10;           // a group is a seed and 4 of its nearest neighbours
+  // Neighbours closer than this to the seed are passed over: the invariants' relative
+  // error grows as pixel noise / group spread, and tight groups fail the test by noise.
+  double min_neighbour_distance_px = 30.0;
   double min_shape = 0.05;       // triangleShape below this is "collinear" (paper IV-A)
   double invariant_threshold = 0.1;  // invariantDistance at most this is "coplanar"
   unsigned seed = 1;             // random choices are deterministic given the seed
@@ -29,7 +33,8 @@ struct GroupParams {
 cv::Mat distanceRows(const std::vector<cv::Point2d>& points, const std::vector<int>& seeds);
 
 // Draws groups on demand: a seed (seeds visited in a random order, round after round)
-// with 4 random points among its `neighbours` nearest, every triple well spread. A
+// with 4 random points among its `neighbours` nearest at min_neighbour_distance_px or
+// more (the nearest of all when fewer than 4 are that far), every triple well spread. A
 // seed's row of the distance matrix is computed on its first visit only, so the cost
 // follows the groups drawn, not N x N. Deterministic given params.seed.
 class GroupSampler {
@@ -55,8 +60,9 @@ class GroupSampler {
 std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
                                     const GroupParams& params, int count);
 
-// Paper IV-A + IV-B: groups tried in buildGroups' order until min(max_groups,
-// groups_per_point * N) pass isCoplanarGroup or max_tries were tried.
+// Paper IV-A + IV-B: groups tried in GroupSampler's order until min(max_groups,
+// groups_per_point * N) pass isCoplanarGroup or min(max_tries, tries_per_point * N)
+// were tried. A group drawn again is skipped (it would give the same homography).
 struct CoplanarGroups {
   std::vector<PointGroup> groups;  // the accepted ones
   int tried = 0;

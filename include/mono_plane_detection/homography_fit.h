@@ -1,6 +1,8 @@
 // Least-squares homography between two point sets and its transfer error.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -18,7 +20,13 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
                                          const std::vector<double>& weights = {});
 
 // Distance in pixels between H * from and to (the paper's vote criterion); infinity
-// when H sends the point to infinity.
-double transferError(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to);
+// when H sends the point to infinity. Inline: the vote calls it N x candidates times.
+inline double transferError(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to) {
+  const double w = H(2, 0) * from.x + H(2, 1) * from.y + H(2, 2);
+  if (std::abs(w) < 1e-12) return std::numeric_limits<double>::infinity();
+  const double x = (H(0, 0) * from.x + H(0, 1) * from.y + H(0, 2)) / w;
+  const double y = (H(1, 0) * from.x + H(1, 1) * from.y + H(1, 2)) / w;
+  return std::hypot(x - to.x, y - to.y);
+}
 
 }  // namespace mono_plane_detection

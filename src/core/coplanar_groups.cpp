@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 #include <random>
+#include <set>
 
 #include "mono_plane_detection/cross_ratio.h"
 
@@ -43,15 +44,27 @@ const std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   if (!near.empty()) return near;
   const int n = static_cast<int>(points_.size());
   const int k = std::min(std::max(params_.neighbours, 4), n - 1);
-  const cv::Mat row = distanceRows(points_, {seeds_[slot]});
-  const double* d = row.ptr<double>(0);
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::nth_element(order.begin(), order.begin() + k, order.end(),
-                   [d](int a, int b) { return d[a] < d[b]; });
-  for (int i = 0; i <= k && static_cast<int>(near.size()) < k; ++i) {
-    if (order[i] != seeds_[slot]) near.push_back(order[i]);
+  // Squared distances: the same order as the distance matrix row, without sqrt.
+  const cv::Point2d& a = points_[seeds_[slot]];
+  std::vector<double> d(n);
+  for (int j = 0; j < n; ++j) {
+    const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
+    d[j] = dx * dx + dy * dy;
   }
+  const double min2 = params_.min_neighbour_distance_px * params_.min_neighbour_distance_px;
+  auto candidatesFarther = [&](double floor2) {
+    std::vector<int> out;
+    for (int j = 0; j < n; ++j) {
+      if (j != seeds_[slot] && d[j] >= floor2) out.push_back(j);
+    }
+    return out;
+  };
+  std::vector<int> order = candidatesFarther(min2);
+  if (order.size() < 4) order = candidatesFarther(-1.0);
+  const int count = std::min(k, static_cast<int>(order.size()));
+  std::nth_element(order.begin(), order.begin() + (count - 1), order.end(),
+                   [&d](int i, int j) { return d[i] < d[j]; });
+  near.assign(order.begin(), order.begin() + count);
   return near;
 }
 
@@ -90,10 +103,16 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
   CoplanarGroups out;
   const long wanted = std::min<long>(params.max_groups,
                                      static_cast<long>(params.groups_per_point) * view2.size());
+  const long max_tries = std::min<long>(params.max_tries,
+                                        static_cast<long>(params.tries_per_point) * view2.size());
   GroupSampler sampler(view2, params);
+  std::set<PointGroup> seen;
   PointGroup g;
-  while (static_cast<long>(out.groups.size()) < wanted && out.tried < params.max_tries && sampler.next(g)) {
+  while (static_cast<long>(out.groups.size()) < wanted && out.tried < max_tries && sampler.next(g)) {
     ++out.tried;
+    PointGroup key = g;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) continue;
     if (isCoplanarGroup(g, view1, view2, params)) out.groups.push_back(g);
   }
   return out;

@@ -1,7 +1,6 @@
 #include "mono_plane_detection/homography_fit.h"
 
 #include <cmath>
-#include <limits>
 
 #include <Eigen/Dense>
 
@@ -34,16 +33,18 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   const auto Tt = normaliser(to);
   if (!Tf || !Tt) return std::nullopt;
 
-  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
-  Eigen::Matrix<double, 2, 9> rows;
+  // Two DLT rows per point, each scaled by sqrt(weight), then one product A^T A.
+  Eigen::Matrix<double, Eigen::Dynamic, 9> A(2 * n, 9);
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
     const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
-    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(),
-        a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
-    const double w = weights.empty() ? 1.0 : weights[i];
-    normal.noalias() += w * rows.transpose() * rows;
+    const double w = weights.empty() ? 1.0 : std::sqrt(std::max(0.0, weights[i]));
+    A.row(2 * i) << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y();
+    A.row(2 * i + 1) << a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
+    A.row(2 * i) *= w;
+    A.row(2 * i + 1) *= w;
   }
+  const Eigen::Matrix<double, 9, 9> normal = A.transpose() * A;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
   if (solver.info() != Eigen::Success) return std::nullopt;
   // A second (near-)zero eigenvalue means the points do not fix H (e.g. collinear).
@@ -59,14 +60,6 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) out(r, c) = H(r, c);
   return out;
-}
-
-double transferError(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to) {
-  const double w = H(2, 0) * from.x + H(2, 1) * from.y + H(2, 2);
-  if (std::abs(w) < 1e-12) return std::numeric_limits<double>::infinity();
-  const double x = (H(0, 0) * from.x + H(0, 1) * from.y + H(0, 2)) / w;
-  const double y = (H(1, 0) * from.x + H(1, 1) * from.y + H(1, 2)) / w;
-  return std::hypot(x - to.x, y - to.y);
 }
 
 }  // namespace mono_plane_detection

@@ -146,18 +146,28 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                   const std::vector<bool>& active, double threshold_px,
                   std::vector<int>* vote_bounds) {
+  // With bounds, the likeliest winners are counted first so that the rest can be
+  // skipped; the paper's rule (most votes, the first index on ties) is kept exactly.
+  std::vector<int> order(homographies.size());
+  std::iota(order.begin(), order.end(), 0);
+  if (vote_bounds) {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return (*vote_bounds)[a] > (*vote_bounds)[b]; });
+  }
   Vote vote;
-  for (size_t h = 0; h < homographies.size(); ++h) {
-    // A bound equal to the best can at most tie, and ties go to the earlier one.
-    if (vote_bounds && (*vote_bounds)[h] <= vote.votes) continue;
+  auto beats = [&vote](int votes, int h) {
+    return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
+  };
+  for (int h : order) {
+    if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
     int votes = 0;
     for (size_t i = 0; i < view1.size(); ++i) {
       if (isActive(active, i) && transferError(homographies[h], view1[i], view2[i]) < threshold_px) ++votes;
     }
     if (vote_bounds) (*vote_bounds)[h] = votes;
-    if (votes > vote.votes) {  // strictly more: the first keeps a tie
+    if (beats(votes, h)) {
       vote.votes = votes;
-      vote.winner = static_cast<int>(h);
+      vote.winner = h;
     }
   }
   if (vote.winner >= 0) {
