@@ -92,18 +92,19 @@ TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {
 }
 
 // Multi-plane recovery over a grid of synthetic scenes: 2-4 planes, 0.5-1 px noise,
-// 0-60 % outliers, three scenes each, each run with three group seeds (the method is
-// randomized: a bound on one draw would test luck). Judged against the oracle that
+// 0-60 % outliers, three scenes each, each run with five group seeds: the method is
+// randomized, and a bound on one draw would test luck. Judged against the oracle that
 // knows the true homographies (bestPossibleLabels: 0.7-5.4 % here, the error noise makes
 // unavoidable). The vote threshold follows the noise (4 sigma, at least the paper's
 // 2 px): with sigma = 1 px only 64 % of true inliers are within 2 px.
-// Measured: on 2-3 planes with <= 30 % outliers every run finds every plane and 2 of 36
-// runs are more than 7 points above the oracle (a homography bridging two adjacent
-// planes); over the whole grid 3.1 points above it on average.
+// Measured over 30 group seeds: 3.7 points above the oracle on average (one seed's
+// average: 2.6-5.2); on 2-3 planes with <= 30 % outliers 5 % of runs are more than 7
+// points above it (a homography bridging two adjacent planes) and 1 % miss or split a
+// plane. The bounds sit about three standard deviations beyond those rates.
 TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
   double excess_sum = 0;
-  int runs = 0, easy_runs = 0, easy_far_off = 0;
-  for (unsigned group_seed = 1; group_seed <= 3; ++group_seed) {
+  int runs = 0, easy_runs = 0, easy_far_off = 0, easy_wrong_count = 0;
+  for (unsigned group_seed = 1; group_seed <= 5; ++group_seed) {
     for (int planes = 2; planes <= 4; ++planes) {
       for (double outliers : {0.0, 0.3, 0.6}) {
         for (unsigned seed = 1; seed <= 3; ++seed) {
@@ -121,11 +122,9 @@ TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
               misclassificationError(scene.labels, result.labels) -
               misclassificationError(scene.labels, bestPossibleLabels(scene, params.vote_threshold_px));
           if (planes <= 3 && outliers <= 0.3) {
-            EXPECT_EQ(static_cast<int>(result.planes.size()), planes)
-                << planes << " planes, " << outliers << " outliers, seed " << seed
-                << ", group seed " << group_seed;
             ++easy_runs;
             easy_far_off += excess > 0.07;
+            easy_wrong_count += static_cast<int>(result.planes.size()) != planes;
           }
           excess_sum += excess;
           ++runs;
@@ -133,11 +132,13 @@ TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
       }
     }
   }
-  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d runs; "
-              "%d of %d runs with 2-3 planes and <= 30 %% outliers more than 7 points above\n",
-              100 * excess_sum / runs, runs, easy_far_off, easy_runs);
-  EXPECT_LE(easy_far_off, 3);
-  EXPECT_LT(excess_sum / runs, 0.045);
+  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d runs; of %d "
+              "runs with 2-3 planes and <= 30 %% outliers %d more than 7 points above, %d with a "
+              "wrong plane count\n",
+              100 * excess_sum / runs, runs, easy_runs, easy_far_off, easy_wrong_count);
+  EXPECT_LT(excess_sum / runs, 0.05);
+  EXPECT_LE(easy_far_off, 8);
+  EXPECT_LE(easy_wrong_count, 3);
 }
 
 TEST(SegmentPlanes, PlanesAreSortedAndConsistentWithLabels) {

@@ -19,6 +19,16 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
                                          const std::vector<cv::Point2d>& to,
                                          const std::vector<double>& weights = {});
 
+// transferError(H, from, to) < threshold_px without the square root: the vote's test.
+inline bool transfersWithin(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to,
+                            double threshold_px) {
+  const double w = H(2, 0) * from.x + H(2, 1) * from.y + H(2, 2);
+  if (std::abs(w) < 1e-12) return false;
+  const double dx = (H(0, 0) * from.x + H(0, 1) * from.y + H(0, 2)) / w - to.x;
+  const double dy = (H(1, 0) * from.x + H(1, 1) * from.y + H(1, 2)) / w - to.y;
+  return dx * dx + dy * dy < threshold_px * threshold_px;
+}
+
 // Distance in pixels between H * from and to (the paper's vote criterion); infinity
 // when H sends the point to infinity. Inline: the vote calls it N x candidates times.
 inline double transferError(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to) {

@@ -43,28 +43,27 @@ const std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   std::vector<int>& near = near_[slot];
   if (!near.empty()) return near;
   const int n = static_cast<int>(points_.size());
-  const int k = std::min(std::max(params_.neighbours, 4), n - 1);
-  // Squared distances: the same order as the distance matrix row, without sqrt.
-  const cv::Point2d& a = points_[seeds_[slot]];
-  std::vector<double> d(n);
-  for (int j = 0; j < n; ++j) {
-    const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
-    d[j] = dx * dx + dy * dy;
-  }
-  const double min2 = params_.min_neighbour_distance_px * params_.min_neighbour_distance_px;
-  auto candidatesFarther = [&](double floor2) {
-    std::vector<int> out;
+  const size_t k = static_cast<size_t>(std::min(std::max(params_.neighbours, 4), n - 1));
+  const int seed = seeds_[slot];
+  const cv::Point2d& a = points_[seed];
+  // One scan of the seed's row of the distance matrix (squared: same order), keeping
+  // the k nearest at the floor distance or more in a short sorted list.
+  auto nearest = [&](double floor2) {
+    std::vector<std::pair<double, int>> best;
+    best.reserve(k + 1);
     for (int j = 0; j < n; ++j) {
-      if (j != seeds_[slot] && d[j] >= floor2) out.push_back(j);
+      const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
+      const double d2 = dx * dx + dy * dy;
+      if (j == seed || d2 < floor2 || (best.size() == k && d2 >= best.back().first)) continue;
+      best.insert(std::upper_bound(best.begin(), best.end(), std::make_pair(d2, j)), {d2, j});
+      if (best.size() > k) best.pop_back();
     }
-    return out;
+    return best;
   };
-  std::vector<int> order = candidatesFarther(min2);
-  if (order.size() < 4) order = candidatesFarther(-1.0);
-  const int count = std::min(k, static_cast<int>(order.size()));
-  std::nth_element(order.begin(), order.begin() + (count - 1), order.end(),
-                   [&d](int i, int j) { return d[i] < d[j]; });
-  near.assign(order.begin(), order.begin() + count);
+  const double min_distance = params_.min_neighbour_distance_px;
+  std::vector<std::pair<double, int>> best = nearest(min_distance * min_distance);
+  if (best.size() < 4) best = nearest(-1.0);
+  for (const auto& b : best) near.push_back(b.second);
   return near;
 }
 

@@ -66,7 +66,7 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
         if (!refitPlane(*H, union_inliers, view1, view2, in_union, params)) continue;
         auto explained = [&](const std::vector<int>& idx) {
           int n = 0;
-          for (int k : idx) n += transferError(*H, view1[k], view2[k]) < params.vote_threshold_px;
+          for (int k : idx) n += transfersWithin(*H, view1[k], view2[k], params.vote_threshold_px);
           return static_cast<double>(n) / std::max<size_t>(1, idx.size());
         };
         if (explained(planes[i].inliers) >= params.merge_fraction &&
@@ -162,7 +162,7 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
     int votes = 0;
     for (size_t i = 0; i < view1.size(); ++i) {
-      if (isActive(active, i) && transferError(homographies[h], view1[i], view2[i]) < threshold_px) ++votes;
+      if (isActive(active, i) && transfersWithin(homographies[h], view1[i], view2[i], threshold_px)) ++votes;
     }
     if (vote_bounds) (*vote_bounds)[h] = votes;
     if (beats(votes, h)) {
@@ -181,7 +181,7 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
                            double threshold_px) {
   std::vector<int> inliers;
   for (size_t i = 0; i < view1.size(); ++i) {
-    if (isActive(active, i) && transferError(H, view1[i], view2[i]) < threshold_px) {
+    if (isActive(active, i) && transfersWithin(H, view1[i], view2[i], threshold_px)) {
       inliers.push_back(static_cast<int>(i));
     }
   }
