@@ -45,7 +45,7 @@ class GroupSampler {
   bool next(PointGroup& group);
 
  private:
-  const std::vector<int>& neighboursOf(size_t seed_slot);
+  std::vector<int>& neighboursOf(size_t seed_slot);
 
   const std::vector<cv::Point2d>& points_;
   GroupParams params_;

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 #include <random>
-#include <set>
+#include <unordered_set>
 
 #include "mono_plane_detection/cross_ratio.h"
 
@@ -13,6 +13,15 @@ namespace {
 std::array<cv::Point2d, 5> pick(const PointGroup& g, const std::vector<cv::Point2d>& p) {
   return {p[g[0]], p[g[1]], p[g[2]], p[g[3]], p[g[4]]};
 }
+
+// Hash of a group's sorted indices, for skipping groups drawn again.
+struct GroupHash {
+  size_t operator()(const PointGroup& g) const {
+    size_t h = 0;
+    for (int i : g) h = h * 1000003u + static_cast<size_t>(i);
+    return h;
+  }
+};
 
 }  // namespace
 
@@ -39,7 +48,7 @@ GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupPa
   near_.resize(seeds_.size());
 }
 
-const std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
+std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   std::vector<int>& near = near_[slot];
   if (!near.empty()) return near;
   const int n = static_cast<int>(points_.size());
@@ -74,7 +83,8 @@ bool GroupSampler::next(PointGroup& group) {
   const long give_up = 4L * static_cast<long>(seeds_.size()) + 64;
   while (failures_in_a_row_ < give_up) {
     const size_t slot = static_cast<size_t>(draws_++ % static_cast<long>(seeds_.size()));
-    std::vector<int> candidates = neighboursOf(slot);
+    // Shuffled in place: any order of the list is as good for the next draw.
+    std::vector<int>& candidates = neighboursOf(slot);
     for (int k = 0; k < 4; ++k) {  // partial Fisher-Yates: 4 distinct neighbours
       std::uniform_int_distribution<int> pick_one(k, static_cast<int>(candidates.size()) - 1);
       std::swap(candidates[k], candidates[pick_one(rng_)]);
@@ -105,7 +115,8 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
   const long max_tries = std::min<long>(params.max_tries,
                                         static_cast<long>(params.tries_per_point) * view2.size());
   GroupSampler sampler(view2, params);
-  std::set<PointGroup> seen;
+  std::unordered_set<PointGroup, GroupHash> seen;
+  seen.reserve(static_cast<size_t>(max_tries));
   PointGroup g;
   while (static_cast<long>(out.groups.size()) < wanted && out.tried < max_tries && sampler.next(g)) {
     ++out.tried;

@@ -27,10 +27,17 @@ bool wellSpread(const std::array<cv::Point2d, 5>& p, double min_shape) {
   for (const auto& q : p) {
     if (!std::isfinite(q.x) || !std::isfinite(q.y)) return false;
   }
+  // triangleShape for all 10 triples, with each of the 10 edges measured once: this
+  // runs for every group tried.
+  double edge2[5][5];
+  for (int i = 0; i < 5; ++i)
+    for (int j = i + 1; j < 5; ++j) edge2[i][j] = (p[i] - p[j]).dot(p[i] - p[j]);
   for (int i = 0; i < 5; ++i)
     for (int j = i + 1; j < 5; ++j)
-      for (int k = j + 1; k < 5; ++k)
-        if (triangleShape(p[i], p[j], p[k]) < min_shape) return false;
+      for (int k = j + 1; k < 5; ++k) {
+        const double longest2 = std::max({edge2[i][j], edge2[j][k], edge2[i][k]});
+        if (!(longest2 > 0.0) || std::abs(det3(p[i], p[j], p[k])) < min_shape * longest2) return false;
+      }
   return true;
 }
 

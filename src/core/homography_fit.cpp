@@ -33,18 +33,18 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   const auto Tt = normaliser(to);
   if (!Tf || !Tt) return std::nullopt;
 
-  // Two DLT rows per point, each scaled by sqrt(weight), then one product A^T A.
-  Eigen::Matrix<double, Eigen::Dynamic, 9> A(2 * n, 9);
+  // The normal matrix A^T W A summed over points: fixed-size rank-2 updates, lazily
+  // evaluated, so nothing is allocated (this runs for hundreds of 5-point groups).
+  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
+  Eigen::Matrix<double, 2, 9> rows;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
     const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
-    const double w = weights.empty() ? 1.0 : std::sqrt(std::max(0.0, weights[i]));
-    A.row(2 * i) << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y();
-    A.row(2 * i + 1) << a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
-    A.row(2 * i) *= w;
-    A.row(2 * i + 1) *= w;
+    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(),
+        a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
+    const double w = weights.empty() ? 1.0 : weights[i];
+    normal.noalias() += (w * rows.transpose()).lazyProduct(rows);
   }
-  const Eigen::Matrix<double, 9, 9> normal = A.transpose() * A;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
   if (solver.info() != Eigen::Success) return std::nullopt;
   // A second (near-)zero eigenvalue means the points do not fix H (e.g. collinear).
