@@ -16,16 +16,22 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps build test bench eval clean
+.PHONY: deps link build test bench eval clean
 
 deps:
 	@scripts/install_deps.sh
 
-$(WS)/src/mono_plane_detection:
+# The package in the workspace links every top-level entry of the repository but
+# build/ itself: linking the whole repository would make a loop that rosrun's
+# `find -L` walks into and reports.
+PKG := $(WS)/src/mono_plane_detection
+link:
 	@mkdir -p $(WS)/src
-	@ln -sfn $(REPO) $(WS)/src/mono_plane_detection
+	@[ ! -L $(PKG) ] || rm $(PKG)
+	@mkdir -p $(PKG)
+	@for f in $(REPO)/* $(REPO)/.ci; do [ "$$(basename $$f)" = build ] || ln -sfn $$f $(PKG)/; done
 
-build: deps $(WS)/src/mono_plane_detection
+build: deps link
 	@$(CATKIN)
 
 test: build

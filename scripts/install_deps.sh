@@ -13,7 +13,8 @@ PACKAGES=(
   python3-roslaunch python3-rosmaster python3-rostopic rosbash
   librosbag-dev python3-rosbag
   ros-std-msgs ros-sensor-msgs python3-sensor-msgs
-  libopencv-dev libeigen3-dev
+  libgeometry-msgs-dev ros-geometry-msgs libtf2-msgs-dev ros-tf2-msgs python3-tf2-msgs
+  libyaml-cpp-dev libopencv-dev libeigen3-dev
 )
 
 missing=()
