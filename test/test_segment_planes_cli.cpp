@@ -1,45 +1,17 @@
 // The segment_planes program: output format, options and exit codes.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-#include <fstream>
 #include <sstream>
 
 #include "mono_plane_detection/synthetic_two_view.h"
+#include "run_program.h"
 
 using namespace mono_plane_detection;
 
 namespace {
 
-std::string errPath() { return std::string(::testing::TempDir()) + "segment_planes_stderr.txt"; }
-
-struct ProgramRun {
-  int code;
-  std::string out;
-};
-
-ProgramRun run(const std::string& args) {
-  const std::string command = std::string(SEGMENT_PLANES_PATH) + " " + args + " 2>" + errPath();
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string out;
-  char buffer[4096];
-  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) out.append(buffer, n);
-  const int status = pclose(pipe);
-  return {WEXITSTATUS(status), out};
-}
-
-std::string stderrText() {
-  std::ifstream in(errPath());
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string writeFile(const std::string& name, const std::string& text) {
-  const std::string path = std::string(::testing::TempDir()) + name;
-  std::ofstream(path) << text;
-  return path;
-}
+ProgramRun run(const std::string& args) { return runProgram(SEGMENT_PLANES_PATH, args); }
+std::string writeFile(const std::string& name, const std::string& text) { return writeTempFile(name, text); }
 
 }  // namespace
 
@@ -54,7 +26,7 @@ TEST(SegmentPlanesCli, LabelsOnePerLineMatchingTheTruth) {
          << scene.view2[i].y << "\n";
   }
   const ProgramRun r = run("--threshold 3 " + writeFile("scene.txt", text.str()));
-  ASSERT_EQ(r.code, 0) << stderrText();
+  ASSERT_EQ(r.code, 0) << r.err;
   std::vector<int> labels;
   std::istringstream in(r.out);
   for (int l; in >> l;) labels.push_back(l);
@@ -78,13 +50,13 @@ TEST(SegmentPlanesCli, FewerThanFivePointsAreAllZero) {
 TEST(SegmentPlanesCli, MalformedInputNamesTheLineAndExitsTwo) {
   ProgramRun r = run(writeFile("bad.txt", "1 2 3 4\n1 2 3\n"));
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(stderrText().find("line 2"), std::string::npos);
+  EXPECT_NE(r.err.find("line 2"), std::string::npos);
   r = run(writeFile("nan.txt", "1 2 3 4\nnan 2 3 4\n"));
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(stderrText().find("line 2"), std::string::npos);
+  EXPECT_NE(r.err.find("line 2"), std::string::npos);
   r = run(writeFile("text.txt", "hello world\n"));
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(stderrText().find("line 1"), std::string::npos);
+  EXPECT_NE(r.err.find("line 1"), std::string::npos);
 }
 
 TEST(SegmentPlanesCli, OptionsAndUsage) {

@@ -121,6 +121,26 @@ TEST(SequenceWriter, SameSeedSameBytes) {
   EXPECT_NE(bytes(temp("a.bag")), bytes(temp("c.bag")));
 }
 
+TEST(SequenceWriter, ExposureSwingBrightensAndDarkens) {
+  SequenceSpec spec;
+  spec.frames = 91;  // 3 s at 30 fps: the gain peaks at 1 s and bottoms at 3 s
+  spec.trajectory.name = "rotation";
+  spec.trajectory.rotation_amplitude_deg = 0;  // a still camera: only the exposure changes
+  spec.exposure_swing = 0.3;
+  writeSequence(spec, temp("exp.bag"), temp("exp.yaml"));
+  rosbag::Bag bag(temp("exp.bag"));
+  std::vector<double> means;
+  for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/camera/image_raw"))) {
+    const auto image = m.instantiate<sensor_msgs::Image>();
+    double sum = 0;
+    for (uint8_t v : image->data) sum += v;
+    means.push_back(sum / image->data.size());
+  }
+  ASSERT_EQ(means.size(), 91u);
+  EXPECT_NEAR(means[30] / means[0], 1.3, 0.03);  // saturation at 255 keeps it a little under
+  EXPECT_NEAR(means[90] / means[0], 0.7, 0.02);
+}
+
 TEST(SequenceWriter, ColourEncodingAndBadSpecs) {
   SequenceSpec spec = shortSpec();
   spec.frames = 2;

@@ -25,17 +25,18 @@ class SceneRenderer {
   // camera has radial distortion.
   SceneRenderer(const IndoorScene& scene, const CameraModel& camera, const RenderOptions& options);
 
-  // The CV_8UC1 image seen from world_from_camera. noise_seed makes the noise repeatable.
-  cv::Mat render(const Pose& world_from_camera, unsigned noise_seed = 0) const;
+  // The CV_8UC1 image seen from world_from_camera. noise_seed makes the noise repeatable;
+  // gain multiplies options.exposure for this image (exposure changing over a sequence).
+  cv::Mat render(const Pose& world_from_camera, unsigned noise_seed = 0, double gain = 1.0) const;
   // Motion blur: the mean of the renders at the given poses (one exposure's path).
-  cv::Mat renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed = 0) const;
+  cv::Mat renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed = 0, double gain = 1.0) const;
 
   // The unit ray of pixel (u, v) in the camera frame (used by tests).
   cv::Vec3d ray(double u, double v) const;
 
  private:
   cv::Mat renderFloat(const Pose& world_from_camera) const;  // CV_32F, full resolution
-  cv::Mat finish(cv::Mat image, unsigned noise_seed) const;
+  cv::Mat finish(cv::Mat image, unsigned noise_seed, double gain) const;
 
   const IndoorScene& scene_;
   CameraModel camera_;

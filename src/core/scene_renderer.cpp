@@ -105,8 +105,8 @@ cv::Mat SceneRenderer::renderFloat(const Pose& pose) const {
   return image;
 }
 
-cv::Mat SceneRenderer::finish(cv::Mat image, unsigned noise_seed) const {
-  image *= options_.exposure;
+cv::Mat SceneRenderer::finish(cv::Mat image, unsigned noise_seed, double gain) const {
+  image *= options_.exposure * gain;
   if (options_.noise_sigma > 0) {
     cv::Mat noise(image.size(), CV_32F);
     cv::RNG rng(noise_seed + 1);
@@ -118,15 +118,16 @@ cv::Mat SceneRenderer::finish(cv::Mat image, unsigned noise_seed) const {
   return out;
 }
 
-cv::Mat SceneRenderer::render(const Pose& pose, unsigned noise_seed) const {
-  return finish(renderFloat(pose), noise_seed);
+cv::Mat SceneRenderer::render(const Pose& pose, unsigned noise_seed, double gain) const {
+  return finish(renderFloat(pose), noise_seed, gain);
 }
 
-cv::Mat SceneRenderer::renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed) const {
+cv::Mat SceneRenderer::renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed,
+                                     double gain) const {
   if (poses.empty()) return cv::Mat::zeros(camera_.size, CV_8U);
   cv::Mat sum = cv::Mat::zeros(camera_.size, CV_32F);
   for (const auto& p : poses) sum += renderFloat(p);
-  return finish(sum / static_cast<double>(poses.size()), noise_seed);
+  return finish(sum / static_cast<double>(poses.size()), noise_seed, gain);
 }
 
 }  // namespace mono_plane_detection

@@ -1,6 +1,7 @@
 #include "sequence_writer.h"
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <stdexcept>
 
@@ -58,6 +59,8 @@ sensor_msgs::CameraInfo cameraInfo(const SequenceSpec& spec, const std_msgs::Hea
 void validate(const SequenceSpec& spec) {
   if (spec.frames < 1) throw std::runtime_error("frames must be at least 1");
   if (!(spec.fps > 0)) throw std::runtime_error("fps must be positive");
+  if (!(spec.exposure_swing >= 0 && spec.exposure_swing < 1))
+    throw std::runtime_error("exposure swing must be in [0, 1)");
   if (spec.encoding != "mono8" && spec.encoding != "bgr8")
     throw std::runtime_error("encoding must be mono8 or bgr8, not '" + spec.encoding + "'");
   if (spec.camera.size.width < 1 || spec.camera.size.height < 1 || !(spec.camera.fx > 0) || !(spec.camera.fy > 0))
@@ -152,7 +155,8 @@ SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_pa
       poses.push_back(trajectoryPose(spec.trajectory, std::max(0.0, t + dt)));
     }
     const auto start = std::chrono::steady_clock::now();
-    cv::Mat image = renderer.renderBlurred(poses, static_cast<unsigned>(k));
+    const double gain = 1.0 + spec.exposure_swing * std::sin(2 * CV_PI * t / 4.0);
+    cv::Mat image = renderer.renderBlurred(poses, static_cast<unsigned>(k), gain);
     render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (spec.encoding == "bgr8") cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
 

@@ -24,6 +24,7 @@ struct SequenceSpec {
   std::string info_topic = "/camera/camera_info";
   std::string map_frame = "map", ground_truth_frame = "camera_gt";  // tf published as map -> camera_gt
   double start_time_s = 1000.0;               // stamp of the first image
+  double exposure_swing = 0.0;                // exposure varies by +- this share, 4 s period
 };
 
 struct SequenceReport {

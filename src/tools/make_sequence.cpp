@@ -22,7 +22,8 @@ const char* kUsage =
     "  --speed MPS [0.3]   --turn DEG [150]   --seed S [1] (textures, humanoid jerks)\n"
     "  --width W [640] --height H [480] --focal F [525] --k1 K --k2 K [0]  (camera)\n"
     "  --noise SIGMA [0] (grey levels)   --blur N [1] (sub-frames per image)\n"
-    "  --supersample N [1]   --exposure GAIN [1]   --encoding mono8|bgr8 [mono8]\n"
+    "  --supersample N [1]   --exposure GAIN [1]   --exposure-swing S [0] (+-S, 4 s period)\n"
+    "  --encoding mono8|bgr8 [mono8]\n"
     "  --target wall|floor [wall]   --walls 0-4 [4]   --no-ceiling\n"
     "  --yaml FILE [next to the bag]   --quiet   --help\n"
     "exit codes: 0 done, 2 bad usage, 1 could not write\n";
@@ -80,6 +81,7 @@ int main(int argc, char** argv) {
       else if (arg == "--blur") spec.render.blur_subframes = static_cast<int>(positive("--blur"));
       else if (arg == "--supersample") spec.render.supersample = static_cast<int>(positive("--supersample"));
       else if (arg == "--exposure") spec.render.exposure = positive("--exposure");
+      else if (arg == "--exposure-swing") spec.exposure_swing = numeric ? x : positive("--exposure-swing");
       else if (arg == "--walls") {
         if (!numeric || x < 0 || x > 4) return usageError("--walls needs 0 to 4");
         spec.room.walls = static_cast<int>(x);
@@ -111,7 +113,8 @@ int main(int argc, char** argv) {
     }
   } catch (const std::runtime_error& e) {
     std::fprintf(stderr, "make_sequence: %s\n", e.what());
-    return e.what() == std::string() ? 1 : (std::string(e.what()).rfind("cannot write", 0) == 0 ? 1 : 2);
+    const bool could_not_write = std::string(e.what()).rfind("cannot write", 0) == 0;
+    return could_not_write ? 1 : 2;  // otherwise the spec was refused
   }
   return 0;
 }
