@@ -3,6 +3,7 @@
 #   make build   install deps and build the catkin workspace under build/ws
 #   make bench   run the benchmark programs (figures, never pass/fail)
 #   make eval    segment_planes on the AdelaideRMF dev scenes (DATA=folder)
+#   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
 #   make clean   remove build/
 
 SHELL := /bin/bash
@@ -16,7 +17,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build test bench eval clean
+.PHONY: deps link build test bench eval sanitize clean
 
 deps:
 	@scripts/install_deps.sh
@@ -45,6 +46,24 @@ bench: build
 
 eval: build
 	@source $(DEVEL) && scripts/eval_two_view $(DATA)
+
+# Same sources, a second workspace with sanitizers; runs every gtest binary directly
+# (the rostests need a ROS master and stay in `make test`). Any report fails the run.
+ASAN_WS := $(REPO)/build/ws_asan
+SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+sanitize: deps
+	@mkdir -p $(ASAN_WS)/src
+	@[ -e $(ASAN_WS)/src/mono_plane_detection ] || ln -sfn $(PKG) $(ASAN_WS)/src/mono_plane_detection
+	@$(MAKE) --no-print-directory link
+	@cd $(ASAN_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
+	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" tests > $(ASAN_WS)/build.log 2>&1 \
+	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
+	@failed=0; for t in $(ASAN_WS)/devel/lib/mono_plane_detection/test_*; do \
+	  case $$(basename $$t) in test_*_nodelet|test_sequence_playback) continue;; esac; \
+	  if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $$t > $$t.log 2>&1; \
+	  then echo "sanitize: $$(basename $$t) clean"; \
+	  else echo "sanitize: $$(basename $$t) FAILED"; tail -30 $$t.log; failed=1; fi; done; exit $$failed
 
 clean:
 	rm -rf build
