@@ -1,13 +1,13 @@
 // Test support: runs a program of the package and captures its exit code and output.
 #pragma once
 
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <sys/wait.h>
 
 namespace mono_plane_detection {
 

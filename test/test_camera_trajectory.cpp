@@ -6,17 +6,17 @@ using namespace mono_plane_detection;
 
 namespace {
 double degrees(double rad) { return rad * 180 / CV_PI; }
-}
+}  // namespace
 
 TEST(CameraTrajectory, OrientationIsARotationLookingWhereAsked) {
   const cv::Matx33d R = cameraOrientation(0.3, 0.2, 0.05);
   EXPECT_LT(cv::norm(R.t() * R - cv::Matx33d::eye()), 1e-12);
   EXPECT_NEAR(cv::determinant(R), 1.0, 1e-12);
   const cv::Vec3d forward(R(0, 2), R(1, 2), R(2, 2));
-  EXPECT_NEAR(degrees(std::asin(-forward[2])), degrees(0.2), 1e-9);         // pitch down
-  EXPECT_NEAR(std::atan2(-forward[0], forward[1]), 0.3, 1e-12);             // heading
+  EXPECT_NEAR(degrees(std::asin(-forward[2])), degrees(0.2), 1e-9);  // pitch down
+  EXPECT_NEAR(std::atan2(-forward[0], forward[1]), 0.3, 1e-12);      // heading
   const cv::Matx33d level = cameraOrientation(0, 0, 0);
-  EXPECT_LT(cv::norm(level * cv::Vec3d(0, 0, 1) - cv::Vec3d(0, 1, 0)), 1e-12);  // z -> +y
+  EXPECT_LT(cv::norm(level * cv::Vec3d(0, 0, 1) - cv::Vec3d(0, 1, 0)), 1e-12);   // z -> +y
   EXPECT_LT(cv::norm(level * cv::Vec3d(0, 1, 0) - cv::Vec3d(0, 0, -1)), 1e-12);  // y (down) -> -z
 }
 
@@ -50,7 +50,7 @@ TEST(CameraTrajectory, HumanoidBobsAroundTheWheeledPath) {
     min_height = std::min(min_height, h.t[2]);
     max_roll = std::max(max_roll, std::abs(std::asin(h.R(2, 0))));
   }
-  EXPECT_NEAR(max_offset, 0.015, 0.002);             // sway
+  EXPECT_NEAR(max_offset, 0.015, 0.002);              // sway
   EXPECT_NEAR(max_height - min_height, 0.04, 0.002);  // bob +-2 cm
   EXPECT_GT(degrees(max_roll), 1.5);
   EXPECT_LT(degrees(max_roll), 4.0);

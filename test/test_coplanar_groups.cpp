@@ -102,5 +102,6 @@ TEST(CoplanarGroups, FindStopsAtTheCapAndCountsTries) {
   EXPECT_EQ(found.groups.size(), 40u);
   EXPECT_GE(found.tried, 40);
   EXPECT_LE(found.tried, params.max_tries);
-  for (const auto& g : found.groups) EXPECT_TRUE(isCoplanarGroup(g, scene.view1, scene.view2, params));
+  for (const auto& g : found.groups)
+    EXPECT_TRUE(isCoplanarGroup(g, scene.view1, scene.view2, params));
 }

@@ -26,8 +26,8 @@ TEST(CrossRatio, InvariantUnderRandomHomographies) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    const cv::Matx33d H(1 + 0.3 * u(rng), 0.3 * u(rng), 200 * u(rng), 0.3 * u(rng), 1 + 0.3 * u(rng),
-                        200 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 1.0);
+    const cv::Matx33d H(1 + 0.3 * u(rng), 0.3 * u(rng), 200 * u(rng), 0.3 * u(rng),
+                        1 + 0.3 * u(rng), 200 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 1.0);
     const auto other = fivePointInvariants(mapped(H, kFive), 1e-3);
     if (!other) continue;  // a homography can squash a triple nearly flat
     EXPECT_NEAR(other->i1, base->i1, 1e-6 * std::abs(base->i1));
@@ -65,7 +65,8 @@ TEST(CrossRatio, DegenerateGroupsRejected) {
 
 TEST(CrossRatio, TriangleShapeIsScaleFreeAndZeroWhenFlat) {
   EXPECT_NEAR(triangleShape({0, 0}, {1, 0}, {0.5, std::sqrt(3.0) / 2}), std::sqrt(3.0) / 2, 1e-12);
-  EXPECT_NEAR(triangleShape({0, 0}, {1000, 0}, {500, 500 * std::sqrt(3.0)}), std::sqrt(3.0) / 2, 1e-12);
+  EXPECT_NEAR(triangleShape({0, 0}, {1000, 0}, {500, 500 * std::sqrt(3.0)}), std::sqrt(3.0) / 2,
+              1e-12);
   EXPECT_EQ(triangleShape({0, 0}, {1, 1}, {2, 2}), 0.0);
   EXPECT_EQ(triangleShape({3, 3}, {3, 3}, {3, 3}), 0.0);
   EXPECT_TRUE(wellSpread(kFive, 0.05));

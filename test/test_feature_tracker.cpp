@@ -1,9 +1,8 @@
 // FeatureTracker against exact ground truth: views of a texture through known motions.
 #include <gtest/gtest.h>
 
-#include <set>
-
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "tracker_ground_truth.h"
 
@@ -45,8 +44,8 @@ TEST(FeatureTracker, FirstImageSearchesUpToMaxFeatures) {
 
 TEST(FeatureTracker, EasyMotionTrackedBelowFifthOfPixel) {
   FeatureTracker tracker;
-  const auto run = runOnViews(tracker, texture(),
-                              translations(60, kCentred, {1.3, -0.7}, 0.002), kView);
+  const auto run =
+      runOnViews(tracker, texture(), translations(60, kCentred, {1.3, -0.7}, 0.002), kView);
   ASSERT_GT(run.score.errors().size(), 1000u);
   EXPECT_LT(run.score.meanError(), 0.2);
   // A few points on edges slide along them; the forward-backward check cannot see that.
@@ -70,8 +69,8 @@ TEST(FeatureTracker, PrevIndexPointsToSamePointInPreviousState) {
 
 TEST(FeatureTracker, IdsStableOverHundredFrames) {
   FeatureTracker tracker;
-  const auto run = runOnViews(tracker, texture(),
-                              translations(100, kCentred, {0.4, 0.3}, 0.0005), kView);
+  const auto run =
+      runOnViews(tracker, texture(), translations(100, kCentred, {0.4, 0.3}, 0.0005), kView);
   std::set<std::uint64_t> first, last;
   for (const auto& p : run.states.front()) first.insert(p.id);
   for (const auto& p : run.states.back()) last.insert(p.id);
@@ -232,7 +231,8 @@ TEST(FeatureTracker, BlackImageGivesNoPointsAndNoCrash) {
 TEST(FeatureTracker, SizeChangeStartsOver) {
   FeatureTracker tracker;
   tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
-  const auto& points = tracker.process(warpView(texture(), similarity(0, {}, kCentred), {320, 240}));
+  const auto& points =
+      tracker.process(warpView(texture(), similarity(0, {}, kCentred), {320, 240}));
   EXPECT_TRUE(tracker.previous().empty());
   for (const auto& p : points) EXPECT_TRUE(p.is_new);
 }

@@ -44,12 +44,14 @@ TEST(HomographyFit, DegenerateInputGivesNothing) {
                              {{0, 0}, {1, 1}, {2, 2}, {3, 3}, {4, 4}}));  // collinear
   EXPECT_FALSE(fitHomography({{1, 1}, {1, 1}, {1, 1}, {1, 1}}, {{0, 0}, {1, 0}, {0, 1}, {1, 1}}));
   EXPECT_FALSE(fitHomography({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, {{0, 0}, {1, 0}, {0, 1}}));
-  EXPECT_FALSE(fitHomography({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, {{0, 0}, {1, 0}, {0, 1}, {1, 1}}, {1, 1}));
+  EXPECT_FALSE(
+      fitHomography({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, {{0, 0}, {1, 0}, {0, 1}, {1, 1}}, {1, 1}));
 }
 
 TEST(HomographyFit, TransfersWithinAgreesWithTransferError) {
   for (double dx : {0.0, 1.9, 2.1, 5.0}) {
-    EXPECT_EQ(transfersWithin(kH, {30, 40}, transfer(kH, {30, 40}) + cv::Point2d(dx, 0), 2.0), dx < 2.0);
+    EXPECT_EQ(transfersWithin(kH, {30, 40}, transfer(kH, {30, 40}) + cv::Point2d(dx, 0), 2.0),
+              dx < 2.0);
   }
   const cv::Matx33d at_infinity(1, 0, 0, 0, 1, 0, 1, 0, 0);
   EXPECT_FALSE(transfersWithin(at_infinity, {0, 5}, {0, 0}, 1e9));

@@ -120,7 +120,8 @@ TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
           const auto result = segmentPlanes(scene.view1, scene.view2, params);
           const double excess =
               misclassificationError(scene.labels, result.labels) -
-              misclassificationError(scene.labels, bestPossibleLabels(scene, params.vote_threshold_px));
+              misclassificationError(scene.labels,
+                                     bestPossibleLabels(scene, params.vote_threshold_px));
           if (planes <= 3 && outliers <= 0.3) {
             ++easy_runs;
             easy_far_off += excess > 0.07;
@@ -132,10 +133,11 @@ TEST(SegmentPlanes, RecoversEveryPlaneOfSyntheticScenes) {
       }
     }
   }
-  std::printf("synthetic multi-plane: %.2f points above the oracle on average over %d runs; of %d "
-              "runs with 2-3 planes and <= 30 %% outliers %d more than 7 points above, %d with a "
-              "wrong plane count\n",
-              100 * excess_sum / runs, runs, easy_runs, easy_far_off, easy_wrong_count);
+  std::printf(
+      "synthetic multi-plane: %.2f points above the oracle on average over %d runs; of %d "
+      "runs with 2-3 planes and <= 30 %% outliers %d more than 7 points above, %d with a "
+      "wrong plane count\n",
+      100 * excess_sum / runs, runs, easy_runs, easy_far_off, easy_wrong_count);
   EXPECT_LT(excess_sum / runs, 0.05);
   EXPECT_LE(easy_far_off, 8);
   EXPECT_LE(easy_wrong_count, 3);

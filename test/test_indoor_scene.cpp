@@ -10,7 +10,8 @@ TEST(IndoorScene, RoomPlanesFaceTheRobot) {
   const cv::Vec3d start(0, 0, 0.8);
   for (const auto& p : scene.planes) {
     EXPECT_NEAR(cv::norm(p.normal()), 1.0, 1e-12) << p.name;
-    EXPECT_GT(p.normal().dot(start) - p.distance(), 0.5) << p.name << " normal points out of the room";
+    EXPECT_GT(p.normal().dot(start) - p.distance(), 0.5)
+        << p.name << " normal points out of the room";
     for (const auto& c : p.corners()) EXPECT_NEAR(p.normal().dot(c), p.distance(), 1e-12);
   }
   RoomParams bare;
@@ -52,10 +53,12 @@ TEST(IndoorScene, TargetIsPaintedWhereItsCornersSay) {
     EXPECT_EQ(plane.name, where == "wall" ? "front_wall" : "floor");
     EXPECT_NEAR(cv::norm(t.corners[1] - t.corners[0]), 0.297, 1e-12);
     EXPECT_NEAR(cv::norm(t.corners[3] - t.corners[0]), 0.210, 1e-12);
-    for (const auto& corner : t.corners) EXPECT_NEAR(plane.normal().dot(corner), plane.distance(), 1e-12);
+    for (const auto& corner : t.corners)
+      EXPECT_NEAR(plane.normal().dot(corner), plane.distance(), 1e-12);
     // The map frame: corners at (+-w/2, +-h/2, 0), z along the plane's normal.
     const Pose map_from_world = t.world_from_map.inverse();
-    const cv::Vec3d c0 = map_from_world.apply(t.corners[0]), c2 = map_from_world.apply(t.corners[2]);
+    const cv::Vec3d c0 = map_from_world.apply(t.corners[0]),
+                    c2 = map_from_world.apply(t.corners[2]);
     EXPECT_NEAR(c0[0], -0.1485, 1e-12);
     EXPECT_NEAR(c0[1], -0.105, 1e-12);
     EXPECT_NEAR(c2[0], 0.1485, 1e-12);
@@ -64,8 +67,9 @@ TEST(IndoorScene, TargetIsPaintedWhereItsCornersSay) {
     // White inside, black in the border, as texels.
     auto texel = [&](const cv::Vec3d& x) {
       const cv::Vec3d local = x - plane.origin;
-      return plane.texture.at<uchar>(static_cast<int>(std::lround(local.dot(plane.v_axis) * plane.texels_per_m)),
-                                     static_cast<int>(std::lround(local.dot(plane.u_axis) * plane.texels_per_m)));
+      return plane.texture.at<uchar>(
+          static_cast<int>(std::lround(local.dot(plane.v_axis) * plane.texels_per_m)),
+          static_cast<int>(std::lround(local.dot(plane.u_axis) * plane.texels_per_m)));
     };
     EXPECT_EQ(texel(t.centre), 255);
     const cv::Vec3d outward = t.corners[0] - t.centre;

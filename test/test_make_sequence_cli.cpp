@@ -14,8 +14,10 @@ bool exists(const std::string& path) { return std::ifstream(path).good(); }
 
 TEST(MakeSequenceCli, WritesBagAndGroundTruthNextToIt) {
   const std::string bag = std::string(::testing::TempDir()) + "cli_seq.bag";
-  const ProgramRun r = run("--trajectory rotation --frames 3 --width 160 --height 120 --focal 130 "
-                           "--noise 2 --blur 2 --exposure-swing 0.2 --target floor --out " + bag);
+  const ProgramRun r =
+      run("--trajectory rotation --frames 3 --width 160 --height 120 --focal 130 "
+          "--noise 2 --blur 2 --exposure-swing 0.2 --target floor --out " +
+          bag);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(exists(bag));
   EXPECT_TRUE(exists(std::string(::testing::TempDir()) + "cli_seq.yaml"));

@@ -18,7 +18,8 @@ struct Fixture {
 };
 
 // H (view a pixel -> view b pixel) induced by a plane of the scene.
-cv::Matx33d planeHomography(const CameraModel& cam, const Pose& a, const Pose& b, const ScenePlane& p) {
+cv::Matx33d planeHomography(const CameraModel& cam, const Pose& a, const Pose& b,
+                            const ScenePlane& p) {
   const Pose b_from_a = b.inverse() * a;
   const cv::Vec3d n_a = a.R.t() * p.normal();
   const double d_a = p.distance() - p.normal().dot(a.t);  // n_a . X_a = d_a
@@ -77,7 +78,8 @@ TEST(SceneRenderer, PixelsAreTheTextureAtTheHit) {
       const RayHit hit = castRay(f.scene, pose.t, pose.R * renderer.ray(u, v));
       const ScenePlane& p = f.scene.planes[hit.plane];
       cv::Mat texel;
-      cv::getRectSubPix(p.texture, {1, 1}, cv::Point2f(hit.a * p.texels_per_m, hit.b * p.texels_per_m), texel);
+      cv::getRectSubPix(p.texture, {1, 1},
+                        cv::Point2f(hit.a * p.texels_per_m, hit.b * p.texels_per_m), texel);
       EXPECT_NEAR(image.at<uchar>(v, u), texel.at<uchar>(0, 0), 1.5) << u << "," << v;
     }
   }
@@ -110,8 +112,9 @@ TEST(SceneRenderer, PlaneMovesAsItsHomographyPredicts) {
   cv::Mat warp(cv::Matx33f(H.inv() * (1.0 / H.inv()(2, 2))));
   cv::Mat mask = cv::Mat::zeros(ib.size(), CV_8U);
   std::vector<cv::Point2f> in_b;
-  for (const cv::Point2d c : {cv::Point2d(region.x, region.y), cv::Point2d(region.br().x, region.y),
-                              cv::Point2d(region.br().x, region.br().y), cv::Point2d(region.x, region.br().y)}) {
+  for (const cv::Point2d c :
+       {cv::Point2d(region.x, region.y), cv::Point2d(region.br().x, region.y),
+        cv::Point2d(region.br().x, region.br().y), cv::Point2d(region.x, region.br().y)}) {
     const cv::Vec3d q = H * cv::Vec3d(c.x, c.y, 1);
     in_b.emplace_back(q[0] / q[2], q[1] / q[2]);
   }
@@ -120,7 +123,8 @@ TEST(SceneRenderer, PlaneMovesAsItsHomographyPredicts) {
   cv::erode(mask, mask, cv::Mat(), {-1, -1}, 5);
   const cv::Mat initial = warp.clone();
   cv::findTransformECC(ib, ia, warp, cv::MOTION_HOMOGRAPHY,
-                       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-8), mask, 1);
+                       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-8),
+                       mask, 1);
   // Compared over the plane's region in image b (a grid inside the mask).
   double worst = 0, sum = 0;
   int n = 0;

@@ -11,7 +11,9 @@ using namespace mono_plane_detection;
 namespace {
 
 ProgramRun run(const std::string& args) { return runProgram(SEGMENT_PLANES_PATH, args); }
-std::string writeFile(const std::string& name, const std::string& text) { return writeTempFile(name, text); }
+std::string writeFile(const std::string& name, const std::string& text) {
+  return writeTempFile(name, text);
+}
 
 }  // namespace
 

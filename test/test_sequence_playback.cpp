@@ -1,14 +1,13 @@
 // A bag from writeSequence played by `rosbag play`: every image, camera_info and tf
 // arrives, in order, with its stamp.
 #include <gtest/gtest.h>
-
-#include <cstdlib>
-#include <thread>
-
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
+
+#include <cstdlib>
+#include <thread>
 
 #include "../src/sequence/sequence_writer.h"
 
@@ -27,7 +26,9 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
   ros::NodeHandle nh;
   std::vector<double> image_stamps;
   int infos = 0, tfs = 0;
-  auto on_image = [&](const sensor_msgs::ImageConstPtr& m) { image_stamps.push_back(m->header.stamp.toSec()); };
+  auto on_image = [&](const sensor_msgs::ImageConstPtr& m) {
+    image_stamps.push_back(m->header.stamp.toSec());
+  };
   ros::Subscriber images = nh.subscribe<sensor_msgs::Image>("/camera/image_raw", 100, on_image);
   ros::Subscriber info = nh.subscribe<sensor_msgs::CameraInfo>(
       "/camera/camera_info", 100, [&](const sensor_msgs::CameraInfoConstPtr&) { ++infos; });
@@ -44,7 +45,8 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
   player.join();
   ros::spinOnce();
   ASSERT_EQ(image_stamps.size(), 30u);
-  for (size_t k = 0; k < image_stamps.size(); ++k) EXPECT_NEAR(image_stamps[k], 1000.0 + k / 30.0, 1e-6);
+  for (size_t k = 0; k < image_stamps.size(); ++k)
+    EXPECT_NEAR(image_stamps[k], 1000.0 + k / 30.0, 1e-6);
   EXPECT_EQ(infos, 30);
   EXPECT_EQ(tfs, 30);
 }

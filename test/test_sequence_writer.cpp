@@ -1,15 +1,14 @@
 // writeSequence: what the bag and the ground-truth YAML hold, read back.
 #include <gtest/gtest.h>
-
-#include <fstream>
-#include <iterator>
-
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 #include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <iterator>
 
 #include "../src/sequence/sequence_writer.h"
 
@@ -99,7 +98,8 @@ TEST(SequenceWriter, GroundTruthYamlDescribesTheScene) {
     }
   }
   // The map frame is the target's: its corners at z = 0, the front wall through the origin.
-  for (const auto& corner : gt["target"]["corners_map"]) EXPECT_NEAR(corner[2].as<double>(), 0.0, 1e-12);
+  for (const auto& corner : gt["target"]["corners_map"])
+    EXPECT_NEAR(corner[2].as<double>(), 0.0, 1e-12);
   EXPECT_EQ(gt["planes"][1]["name"].as<std::string>(), "front_wall");
   EXPECT_NEAR(gt["planes"][1]["distance_m"].as<double>(), 0.0, 1e-12);
   EXPECT_EQ(gt["camera_gt_in_map"].size(), 10u);

@@ -32,7 +32,8 @@ TEST(SyntheticTwoView, PlanesInduceDistinctHomographies) {
     if (s.labels[i] != 1) continue;
     double nearest_other = 1e9;
     for (size_t k = 1; k < s.homographies.size(); ++k)
-      nearest_other = std::min(nearest_other, transferError(s.homographies[k], s.view1[i], s.view2[i]));
+      nearest_other =
+          std::min(nearest_other, transferError(s.homographies[k], s.view1[i], s.view2[i]));
     EXPECT_GT(nearest_other, 3.0);
   }
 }
@@ -53,7 +54,7 @@ TEST(BestPossibleLabels, ExactDataIsPerfectNoiseIsNot) {
   p.noise_px = 1.0;
   scene = makeTwoViewScene(p);
   const double noisy = misclassificationError(scene.labels, bestPossibleLabels(scene, 4.0));
-  EXPECT_GT(noisy, 0.0);   // near the planes' intersections noise decides
+  EXPECT_GT(noisy, 0.0);  // near the planes' intersections noise decides
   EXPECT_LT(noisy, 0.10);
   // A threshold far below the noise rejects most true points.
   EXPECT_GT(misclassificationError(scene.labels, bestPossibleLabels(scene, 0.5)), 0.5);

@@ -1,14 +1,13 @@
 // Drives TrackerNodelet with images of known motion and bad input; checks `tracks`.
-#include <gtest/gtest.h>
-
-#include <map>
-#include <set>
-
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgproc.hpp>
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/synthetic_views.h"
@@ -36,8 +35,7 @@ class TrackerNodeletTest : public ::testing::Test {
 
   void onTracks(const TracksConstPtr& msg) { received_[msg->header.stamp.toNSec()] = msg; }
 
-  sensor_msgs::ImagePtr makeImage(const cv::Mat& image, const std::string& encoding,
-                                  double stamp) {
+  sensor_msgs::ImagePtr makeImage(const cv::Mat& image, const std::string& encoding, double stamp) {
     std_msgs::Header header;
     header.stamp = ros::Time(stamp);
     header.frame_id = "camera_optical";

@@ -3,9 +3,8 @@
 // rotation in place (the paper's hard case). ROS-free.
 #pragma once
 
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "mono_plane_detection/indoor_scene.h"
 
@@ -22,14 +21,14 @@ struct CameraModel {
 };
 
 struct TrajectoryParams {
-  std::string name = "wheeled";  // wheeled | humanoid | rotation
-  double speed_mps = 0.3;        // forward speed (wheeled, humanoid)
-  double turn_deg = 150;         // total left turn over the sequence (wheeled, humanoid)
-  double duration_s = 10;        // the turn is spread over this time
-  double camera_height_m = 0.8;  // humanoid adds 0.4 m
-  double pitch_down_deg = 10;    // camera tilt towards the floor
+  std::string name = "wheeled";        // wheeled | humanoid | rotation
+  double speed_mps = 0.3;              // forward speed (wheeled, humanoid)
+  double turn_deg = 150;               // total left turn over the sequence (wheeled, humanoid)
+  double duration_s = 10;              // the turn is spread over this time
+  double camera_height_m = 0.8;        // humanoid adds 0.4 m
+  double pitch_down_deg = 10;          // camera tilt towards the floor
   double rotation_amplitude_deg = 60;  // rotation: yaw swings +- this, in place
-  unsigned seed = 1;             // humanoid jerks
+  unsigned seed = 1;                   // humanoid jerks
 };
 
 // world_from_camera at time t (s) with t = 0 the start: in front of the target, looking

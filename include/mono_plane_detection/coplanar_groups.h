@@ -4,28 +4,27 @@
 #pragma once
 
 #include <array>
+#include <opencv2/core.hpp>
 #include <random>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace mono_plane_detection {
 
 using PointGroup = std::array<int, 5>;  // indices into the point arrays
 
 struct GroupParams {
-  int max_groups = 300;          // coplanar groups kept per image, so the cost stays bounded
-  int groups_per_point = 4;      // fewer points -> fewer groups (max_groups still caps)
-  int max_tries = 6000;          // groups tried at most: with many outliers few pass
-  int tries_per_point = 40;      // fewer points -> fewer tries (max_tries still caps)
-  int max_seeds = 2000;          // seed points with a neighbour list (bounds memory)
-  int neighbours = 10;           // a group is a seed and 4 of its nearest neighbours
+  int max_groups = 300;      // coplanar groups kept per image, so the cost stays bounded
+  int groups_per_point = 4;  // fewer points -> fewer groups (max_groups still caps)
+  int max_tries = 6000;      // groups tried at most: with many outliers few pass
+  int tries_per_point = 40;  // fewer points -> fewer tries (max_tries still caps)
+  int max_seeds = 2000;      // seed points with a neighbour list (bounds memory)
+  int neighbours = 10;       // a group is a seed and 4 of its nearest neighbours
   // Neighbours closer than this to the seed are passed over: the invariants' relative
   // error grows as pixel noise / group spread, and tight groups fail the test by noise.
   double min_neighbour_distance_px = 30.0;
-  double min_shape = 0.05;       // triangleShape below this is "collinear" (paper IV-A)
+  double min_shape = 0.05;           // triangleShape below this is "collinear" (paper IV-A)
   double invariant_threshold = 0.1;  // invariantDistance at most this is "coplanar"
-  unsigned seed = 1;             // random choices are deterministic given the seed
+  unsigned seed = 1;                 // random choices are deterministic given the seed
 };
 
 // Distances from each seed to every point: the rows of the paper's distance matrix

@@ -3,17 +3,16 @@
 #pragma once
 
 #include <istream>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace mono_plane_detection {
 
 struct Correspondences {
   std::vector<cv::Point2d> view1, view2;
-  std::string error;  // empty when the whole input was read; otherwise names the line
-  int error_line = 0; // 1-based line of the error
+  std::string error;   // empty when the whole input was read; otherwise names the line
+  int error_line = 0;  // 1-based line of the error
 };
 
 // Stops at the first malformed line: not exactly four numbers, a number that is not

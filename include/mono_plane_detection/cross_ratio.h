@@ -5,9 +5,8 @@
 #pragma once
 
 #include <array>
-#include <optional>
-
 #include <opencv2/core.hpp>
+#include <optional>
 
 namespace mono_plane_detection {
 

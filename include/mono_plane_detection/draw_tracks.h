@@ -1,9 +1,8 @@
 // The paper's figures 2-3: tracked points in red, new points in blue, ids beside them.
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "mono_plane_detection/feature_tracker.h"
 

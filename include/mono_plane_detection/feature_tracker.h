@@ -5,10 +5,9 @@
 
 #include <cstdint>
 #include <limits>
+#include <opencv2/core.hpp>
 #include <unordered_map>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace mono_plane_detection {
 
@@ -20,10 +19,10 @@ struct TrackerParams {
   int block_size = 3;             // px, neighbourhood of the corner score
 
   // Pyramidal Lucas-Kanade (paper II-C).
-  int pyramid_levels = 5;      // levels including full resolution (paper: 5)
-  int window_size_px = 7;      // paper: 3; 7 measured best (README, "LK window size")
-  int max_iterations = 30;     // LK termination: iterations per level
-  double epsilon_px = 0.01;    // LK termination: step size
+  int pyramid_levels = 5;             // levels including full resolution (paper: 5)
+  int window_size_px = 7;             // paper: 3; 7 measured best (README, "LK window size")
+  int max_iterations = 30;            // LK termination: iterations per level
+  double epsilon_px = 0.01;           // LK termination: step size
   double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
 
   // When to search again (paper II-C).
@@ -34,17 +33,17 @@ struct TrackerParams {
   double match_radius_px = 3.0;
 
   // Beyond the paper.
-  bool forward_backward_check = true;   // track back and drop points that do not return
+  bool forward_backward_check = true;    // track back and drop points that do not return
   double forward_backward_max_px = 1.0;  // allowed round-trip error
-  bool reanchor_on_search = true;       // pull live points back onto their corner
-  int reanchor_window_px = 3;           // half-size of the cornerSubPix window
-  double reanchor_max_shift_px = 1.0;   // larger corrections are not trusted
-  bool mask_existing = true;            // no new corner within min_distance of a live point
-  bool reidentify = true;               // give a lost point its old id when it comes back
-  int reid_memory_frames = 150;         // how long a lost point can come back
-  int reid_max_hamming = 30;            // of 256 ORB bits
-  double reid_ratio = 0.8;              // best / second-best Hamming distance
-  double reid_max_radius_px = 20.0;     // from where the image motion says it went
+  bool reanchor_on_search = true;        // pull live points back onto their corner
+  int reanchor_window_px = 3;            // half-size of the cornerSubPix window
+  double reanchor_max_shift_px = 1.0;    // larger corrections are not trusted
+  bool mask_existing = true;             // no new corner within min_distance of a live point
+  bool reidentify = true;                // give a lost point its old id when it comes back
+  int reid_memory_frames = 150;          // how long a lost point can come back
+  int reid_max_hamming = 30;             // of 256 ORB bits
+  double reid_ratio = 0.8;               // best / second-best Hamming distance
+  double reid_max_radius_px = 20.0;      // from where the image motion says it went
 };
 
 // One record of the paper's state arrays.
@@ -86,8 +85,7 @@ std::vector<int> closestClaimWins(const std::vector<int>& claim, const std::vect
 // Paper II-D: for each corner, the index of the point within radius it matches, or -1.
 // When several corners pick the same point, the closest pair wins.
 std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,
-                                      const std::vector<cv::Point2f>& points,
-                                      double radius_px);
+                                      const std::vector<cv::Point2f>& points, double radius_px);
 
 class FeatureTracker {
  public:
@@ -136,7 +134,7 @@ class FeatureTracker {
   int found_at_last_search_ = 0;
   int frames_since_search_ = 0;
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
-  std::vector<LostPoint> lost_;                              // re-identification pool
+  std::vector<LostPoint> lost_;                             // re-identification pool
 };
 
 }  // namespace mono_plane_detection

@@ -3,10 +3,9 @@
 
 #include <cmath>
 #include <limits>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace mono_plane_detection {
 

@@ -3,10 +3,9 @@
 // every dominant plane, by voting again among the points no plane has claimed yet.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "mono_plane_detection/coplanar_groups.h"
 
@@ -23,9 +22,9 @@ struct PlaneParams {
 };
 
 struct Vote {
-  int winner = -1;           // index of the winning homography, -1 when none
-  int votes = 0;             // its votes
-  std::vector<int> voters;   // the points that voted for it
+  int winner = -1;          // index of the winning homography, -1 when none
+  int votes = 0;            // its votes
+  std::vector<int> voters;  // the points that voted for it
 };
 
 // Paper IV-C over the points with active[i] (all when active is empty).
@@ -59,11 +58,11 @@ struct Plane {
 };
 
 struct PlaneSegmentation {
-  std::vector<Plane> planes;   // by support, largest first
-  std::vector<int> labels;     // per point: 0 = no plane, k >= 1 = planes[k-1]
-  int groups_built = 0;        // five-point groups tried (built and tested)
-  int groups_coplanar = 0;     // of those, accepted by the invariant test
-  std::string error;           // why nothing could be done (sizes differ, ...)
+  std::vector<Plane> planes;  // by support, largest first
+  std::vector<int> labels;    // per point: 0 = no plane, k >= 1 = planes[k-1]
+  int groups_built = 0;       // five-point groups tried (built and tested)
+  int groups_coplanar = 0;    // of those, accepted by the invariant test
+  std::string error;          // why nothing could be done (sizes differ, ...)
 };
 
 // Every dominant plane between two views of the same points (view1[i] <-> view2[i]).

@@ -2,9 +2,8 @@
 // ray meets the nearest plane, whose texture is sampled bilinearly. ROS-free.
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "mono_plane_detection/camera_trajectory.h"
 #include "mono_plane_detection/indoor_scene.h"
@@ -12,11 +11,11 @@
 namespace mono_plane_detection {
 
 struct RenderOptions {
-  int supersample = 1;          // rays per pixel side (anti-aliasing): 2 = 4 rays per pixel
-  int blur_subframes = 1;       // motion blur: average of this many poses (renderBlurred)
-  double noise_sigma = 0;       // Gaussian image noise, grey levels
-  double exposure = 1.0;        // intensity gain
-  cv::Scalar background = 0;    // where no plane is hit
+  int supersample = 1;        // rays per pixel side (anti-aliasing): 2 = 4 rays per pixel
+  int blur_subframes = 1;     // motion blur: average of this many poses (renderBlurred)
+  double noise_sigma = 0;     // Gaussian image noise, grey levels
+  double exposure = 1.0;      // intensity gain
+  cv::Scalar background = 0;  // where no plane is hit
 };
 
 class SceneRenderer {
@@ -29,7 +28,8 @@ class SceneRenderer {
   // gain multiplies options.exposure for this image (exposure changing over a sequence).
   cv::Mat render(const Pose& world_from_camera, unsigned noise_seed = 0, double gain = 1.0) const;
   // Motion blur: the mean of the renders at the given poses (one exposure's path).
-  cv::Mat renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed = 0, double gain = 1.0) const;
+  cv::Mat renderBlurred(const std::vector<Pose>& poses, unsigned noise_seed = 0,
+                        double gain = 1.0) const;
 
   // The unit ray of pixel (u, v) in the camera frame (used by tests).
   cv::Vec3d ray(double u, double v) const;

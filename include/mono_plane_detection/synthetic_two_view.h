@@ -3,20 +3,19 @@
 // pixel noise and gross outliers.
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace mono_plane_detection {
 
 struct TwoViewSceneParams {
-  int planes = 3;               // 1..6, each seen in its own vertical strip of view 1
+  int planes = 3;  // 1..6, each seen in its own vertical strip of view 1
   int points_per_plane = 60;
   double outlier_fraction = 0.2;  // share of all points that are random pairs
-  double noise_px = 0.7;        // Gaussian pixel noise in both views
+  double noise_px = 0.7;          // Gaussian pixel noise in both views
   cv::Size image{640, 480};
   double focal_px = 525.0;
-  double baseline_m = 0.5;      // camera 2 moves this far (planes are 2-6 m away)
+  double baseline_m = 0.5;  // camera 2 moves this far (planes are 2-6 m away)
   // Planes are redrawn until their homographies differ by at least this much (median
   // over both strips): closer planes cannot be told apart at a few px of noise.
   double min_separation_px = 10.0;

@@ -4,23 +4,23 @@
 #pragma once
 
 #include <array>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "mono_plane_detection/indoor_scene.h"
 
 namespace mono_plane_detection {
 
 struct TargetParams {
-  double width_m = 0.297;   // white rectangle, the longer side
+  double width_m = 0.297;  // white rectangle, the longer side
   double height_m = 0.210;
-  double min_area_px = 400;          // smaller candidates are ignored
-  double max_aspect_distortion = 2.5;  // image long/short side may differ from width/height by this factor
-  double min_contrast = 120;         // grey levels between the white inside and the dark ring
-  double min_structure = 0.95;       // share of the inside above / the ring below Otsu's level
-  double max_ring_ratio = 0.3;       // the black border's mean over the white inside's mean
+  double min_area_px = 400;  // smaller candidates are ignored
+  double max_aspect_distortion =
+      2.5;                      // image long/short side may differ from width/height by this factor
+  double min_contrast = 120;    // grey levels between the white inside and the dark ring
+  double min_structure = 0.95;  // share of the inside above / the ring below Otsu's level
+  double max_ring_ratio = 0.3;  // the black border's mean over the white inside's mean
 };
 
 struct TargetDetection {
@@ -41,7 +41,7 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params = T
 std::array<cv::Point3d, 4> targetCornersInMap(const TargetParams& params);
 
 struct TargetPose {
-  Pose map_from_camera;            // the camera's pose in the map frame
+  Pose map_from_camera;              // the camera's pose in the map frame
   double reprojection_error_px = 0;  // rms over the 4 corners
 };
 

@@ -5,9 +5,8 @@
 
 #include <cstdint>
 #include <map>
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "mono_plane_detection/feature_tracker.h"
 

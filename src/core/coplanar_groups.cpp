@@ -103,22 +103,25 @@ std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
                                     const GroupParams& params, int count) {
   std::vector<PointGroup> groups;
   GroupSampler sampler(points, params);
-  for (PointGroup g; static_cast<int>(groups.size()) < count && sampler.next(g);) groups.push_back(g);
+  for (PointGroup g; static_cast<int>(groups.size()) < count && sampler.next(g);)
+    groups.push_back(g);
   return groups;
 }
 
 CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
-                                  const std::vector<cv::Point2d>& view2, const GroupParams& params) {
+                                  const std::vector<cv::Point2d>& view2,
+                                  const GroupParams& params) {
   CoplanarGroups out;
-  const long wanted = std::min<long>(params.max_groups,
-                                     static_cast<long>(params.groups_per_point) * view2.size());
-  const long max_tries = std::min<long>(params.max_tries,
-                                        static_cast<long>(params.tries_per_point) * view2.size());
+  const long wanted =
+      std::min<long>(params.max_groups, static_cast<long>(params.groups_per_point) * view2.size());
+  const long max_tries =
+      std::min<long>(params.max_tries, static_cast<long>(params.tries_per_point) * view2.size());
   GroupSampler sampler(view2, params);
   std::unordered_set<PointGroup, GroupHash> seen;
   seen.reserve(static_cast<size_t>(max_tries));
   PointGroup g;
-  while (static_cast<long>(out.groups.size()) < wanted && out.tried < max_tries && sampler.next(g)) {
+  while (static_cast<long>(out.groups.size()) < wanted && out.tried < max_tries &&
+         sampler.next(g)) {
     ++out.tried;
     PointGroup key = g;
     std::sort(key.begin(), key.end());

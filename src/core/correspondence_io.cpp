@@ -33,8 +33,9 @@ Correspondences readCorrespondences(std::istream& in) {
     const std::vector<std::string> t = tokens(line);
     if (t.empty()) continue;
     if (t.size() != 4) {
-      out.error = "line " + std::to_string(number) + ": expected 4 numbers \"x1 y1 x2 y2\", found " +
-                  std::to_string(t.size()) + " fields";
+      out.error = "line " + std::to_string(number) +
+                  ": expected 4 numbers \"x1 y1 x2 y2\", found " + std::to_string(t.size()) +
+                  " fields";
       out.error_line = number;
       return out;
     }

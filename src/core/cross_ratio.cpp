@@ -36,7 +36,8 @@ bool wellSpread(const std::array<cv::Point2d, 5>& p, double min_shape) {
     for (int j = i + 1; j < 5; ++j)
       for (int k = j + 1; k < 5; ++k) {
         const double longest2 = std::max({edge2[i][j], edge2[j][k], edge2[i][k]});
-        if (!(longest2 > 0.0) || std::abs(det3(p[i], p[j], p[k])) < min_shape * longest2) return false;
+        if (!(longest2 > 0.0) || std::abs(det3(p[i], p[j], p[k])) < min_shape * longest2)
+          return false;
       }
   return true;
 }

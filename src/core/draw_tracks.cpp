@@ -1,8 +1,7 @@
 #include "mono_plane_detection/draw_tracks.h"
 
-#include <string>
-
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 namespace mono_plane_detection {
 
@@ -18,8 +17,8 @@ cv::Mat drawTracks(const cv::Mat& image, const std::vector<TrackedPoint>& points
                               : p.is_new        ? kNewColour
                                                 : kTrackedColour;
     cv::circle(canvas, p.uv, 3, colour, 1, cv::LINE_AA);
-    cv::putText(canvas, std::to_string(p.id), p.uv + cv::Point2f(4.f, -4.f),
-                cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
+    cv::putText(canvas, std::to_string(p.id), p.uv + cv::Point2f(4.f, -4.f), cv::FONT_HERSHEY_PLAIN,
+                0.8, colour, 1, cv::LINE_AA);
   }
   return canvas;
 }

@@ -2,11 +2,10 @@
 
 #include <algorithm>
 #include <limits>
-#include <stdexcept>
-
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
+#include <stdexcept>
 
 namespace mono_plane_detection {
 namespace {
@@ -77,8 +76,8 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
 
   // Paper II-D: the search runs on this image, before the next one is loaded, so the
   // points still tracked here continue into the new set.
-  if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()),
-                   frames_since_search_, params_)) {
+  if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()), frames_since_search_,
+                   params_)) {
     search(gray);
   }
   previous_pyramid_ = std::move(pyramid);
@@ -86,8 +85,7 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   return current_;
 }
 
-void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid,
-                                       const cv::Size& size) {
+void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
   if (previous_.empty() || previous_pyramid_.empty()) return;
   const cv::Size window(params_.window_size_px, params_.window_size_px);
   const int max_level = std::max(0, params_.pyramid_levels - 1);
@@ -104,8 +102,8 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid,
   std::vector<cv::Point2f> back;
   if (params_.forward_backward_check) {
     back = after;
-    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid_, after, back, back_status, error,
-                             window, max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid_, after, back, back_status, error, window,
+                             max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
                              params_.min_eigen_threshold);
     back_status.resize(before.size(), 0);
   }
@@ -168,8 +166,8 @@ void FeatureTracker::search(const cv::Mat& gray) {
                          : params_.max_features;
   if (wanted > 0) {
     const cv::Mat mask = params_.mask_existing ? searchMask(gray.size()) : cv::Mat();
-    cv::goodFeaturesToTrack(gray, corners, wanted, params_.quality_level,
-                            params_.min_distance_px, mask, params_.block_size);
+    cv::goodFeaturesToTrack(gray, corners, wanted, params_.quality_level, params_.min_distance_px,
+                            mask, params_.block_size);
   }
   if (!corners.empty()) {
     cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
@@ -250,7 +248,8 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
     for (size_t l = 0; l < lost_.size(); ++l) {
       const cv::Point2f d = fresh[f].uv - lost_[l].uv;
       if (d.dot(d) > radius2) continue;
-      const int h = static_cast<int>(cv::norm(descriptors[f], lost_[l].descriptor, cv::NORM_HAMMING));
+      const int h =
+          static_cast<int>(cv::norm(descriptors[f], lost_[l].descriptor, cv::NORM_HAMMING));
       if (h < best_d) {
         second_d = best_d;
         best_d = h;
@@ -259,8 +258,8 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
         second_d = h;
       }
     }
-    const bool distinct = second_d == std::numeric_limits<int>::max() ||
-                          best_d < params_.reid_ratio * second_d;
+    const bool distinct =
+        second_d == std::numeric_limits<int>::max() || best_d < params_.reid_ratio * second_d;
     if (best >= 0 && best_d <= params_.reid_max_hamming && distinct) {
       claim[f] = best;
       claim_distance[f] = best_d;

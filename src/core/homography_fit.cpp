@@ -1,8 +1,7 @@
 #include "mono_plane_detection/homography_fit.h"
 
-#include <cmath>
-
 #include <Eigen/Dense>
+#include <cmath>
 
 namespace mono_plane_detection {
 namespace {
@@ -40,8 +39,8 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
     const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
-    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(),
-        a.x(), a.y(), 1, 0, 0, 0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
+    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(), a.x(), a.y(), 1, 0, 0,
+        0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
     const double w = weights.empty() ? 1.0 : weights[i];
     normal.noalias() += (w * rows.transpose()).lazyProduct(rows);
   }

@@ -83,7 +83,8 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
 }
 
 // Every point goes to the plane that explains it best, or to none.
-std::vector<int> assignPoints(const std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
+std::vector<int> assignPoints(const std::vector<Plane>& planes,
+                              const std::vector<cv::Point2d>& view1,
                               const std::vector<cv::Point2d>& view2, double threshold_px) {
   std::vector<int> labels(view1.size(), 0);
   for (size_t i = 0; i < view1.size(); ++i) {
@@ -115,7 +116,8 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
     const auto smallest = std::min_element(
         members.begin(), members.end(),
         [](const std::vector<int>& a, const std::vector<int>& b) { return a.size() < b.size(); });
-    if (smallest == members.end() || static_cast<int>(smallest->size()) >= params.min_plane_support) {
+    if (smallest == members.end() ||
+        static_cast<int>(smallest->size()) >= params.min_plane_support) {
       return members;
     }
     planes.erase(planes.begin() + (smallest - members.begin()));
@@ -130,7 +132,8 @@ void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>
   std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params);
   for (int round = 0; round < params.refit_iterations; ++round) {
     for (size_t k = 0; k < planes.size(); ++k) {
-      if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]))) planes[k].H = *H;
+      if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k])))
+        planes[k].H = *H;
     }
     std::vector<std::vector<int>> next = keepSupportedPlanes(planes, view1, view2, params);
     const bool stable = next == members;
@@ -162,7 +165,8 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
     int votes = 0;
     for (size_t i = 0; i < view1.size(); ++i) {
-      if (isActive(active, i) && transfersWithin(homographies[h], view1[i], view2[i], threshold_px)) ++votes;
+      if (isActive(active, i) && transfersWithin(homographies[h], view1[i], view2[i], threshold_px))
+        ++votes;
     }
     if (vote_bounds) (*vote_bounds)[h] = votes;
     if (beats(votes, h)) {
@@ -220,8 +224,7 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
   out.labels.assign(view1.size(), 0);
   if (view1.size() < 5) return out;
 
-  std::vector<cv::Matx33d> candidates =
-      coplanarGroupHomographies(view1, view2, params.groups, out);
+  std::vector<cv::Matx33d> candidates = coplanarGroupHomographies(view1, view2, params.groups, out);
   std::vector<bool> active(view1.size());
   for (size_t i = 0; i < view1.size(); ++i) active[i] = finite(view1[i]) && finite(view2[i]);
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 #include "mono_plane_detection/synthetic_views.h"
@@ -66,20 +65,25 @@ StartTarget paintTarget(ScenePlane& plane, int plane_index, double centre_a, dou
     return 1.0;
   };
   {
-    const cv::Point2d lo = texel(centre_a - hw, centre_b - hh), hi = texel(centre_a + hw, centre_b + hh);
-    for (int r = static_cast<int>(std::floor(lo.y)); r <= static_cast<int>(std::floor(hi.y)) + 1; ++r)
-      for (int c = static_cast<int>(std::floor(lo.x)); c <= static_cast<int>(std::floor(hi.x)) + 1; ++c)
+    const cv::Point2d lo = texel(centre_a - hw, centre_b - hh),
+                      hi = texel(centre_a + hw, centre_b + hh);
+    for (int r = static_cast<int>(std::floor(lo.y)); r <= static_cast<int>(std::floor(hi.y)) + 1;
+         ++r)
+      for (int c = static_cast<int>(std::floor(lo.x)); c <= static_cast<int>(std::floor(hi.x)) + 1;
+           ++c)
         blend(r, c, profile(lo.x, hi.x, c) * profile(lo.y, hi.y, r), 255.0);
   }
 
-  auto world = [&](double a, double b) { return plane.origin + a * plane.u_axis + b * plane.v_axis; };
+  auto world = [&](double a, double b) {
+    return plane.origin + a * plane.u_axis + b * plane.v_axis;
+  };
   target.centre = world(centre_a, centre_b);
   target.corners = {world(centre_a - hw, centre_b - hh), world(centre_a + hw, centre_b - hh),
                     world(centre_a + hw, centre_b + hh), world(centre_a - hw, centre_b + hh)};
   const cv::Vec3d z = plane.normal();
-  target.world_from_map.R = cv::Matx33d(plane.u_axis[0], plane.v_axis[0], z[0],
-                                        plane.u_axis[1], plane.v_axis[1], z[1],
-                                        plane.u_axis[2], plane.v_axis[2], z[2]);
+  target.world_from_map.R =
+      cv::Matx33d(plane.u_axis[0], plane.v_axis[0], z[0], plane.u_axis[1], plane.v_axis[1], z[1],
+                  plane.u_axis[2], plane.v_axis[2], z[2]);
   target.world_from_map.t = target.centre;
   return target;
 }
@@ -99,8 +103,8 @@ IndoorScene makeRoom(const RoomParams& params) {
   // Axes are chosen so that u x v points into the room.
   auto add = [&](const std::string& name, const cv::Vec3d& origin, const cv::Vec3d& u,
                  const cv::Vec3d& v, double w, double h) {
-    scene.planes.push_back(makePlane(static_cast<int>(scene.planes.size()) + 1, name, origin, u, v,
-                                     w, h, params));
+    scene.planes.push_back(
+        makePlane(static_cast<int>(scene.planes.size()) + 1, name, origin, u, v, w, h, params));
   };
   add("floor", {x0, -B, 0}, X, Y, W, F + B);
   if (params.walls >= 1) add("front_wall", {x0, F, 0}, X, Z, W, H);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -11,7 +10,8 @@ namespace {
 
 // OpenCV's default 5 iterations leave 0.02 px of error at the image corners with
 // k1 = -0.15; the ground truth must be exact.
-const cv::TermCriteria kUndistortCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-14);
+const cv::TermCriteria kUndistortCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100,
+                                          1e-14);
 
 float bilinear(const cv::Mat& texture, double x, double y) {
   x = std::min(std::max(x, 0.0), texture.cols - 1.001);
@@ -20,7 +20,8 @@ float bilinear(const cv::Mat& texture, double x, double y) {
   const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
   const uchar* r0 = texture.ptr<uchar>(y0);
   const uchar* r1 = texture.ptr<uchar>(y0 + 1);
-  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) +
+         fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
 }
 
 }  // namespace
@@ -48,8 +49,8 @@ SceneRenderer::SceneRenderer(const IndoorScene& scene, const CameraModel& camera
 
 cv::Vec3d SceneRenderer::ray(double u, double v) const {
   std::vector<cv::Point2d> in{{u, v}}, out;
-  cv::undistortPoints(in, out, cv::Mat(camera_.K()), camera_.distortion(), cv::noArray(), cv::noArray(),
-                      kUndistortCriteria);
+  cv::undistortPoints(in, out, cv::Mat(camera_.K()), camera_.distortion(), cv::noArray(),
+                      cv::noArray(), kUndistortCriteria);
   const cv::Vec3d d(out[0].x, out[0].y, 1.0);
   return d / cv::norm(d);
 }

@@ -3,9 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <random>
-
 #include <opencv2/calib3d.hpp>
+#include <random>
 
 #include "mono_plane_detection/homography_fit.h"
 
@@ -29,7 +28,8 @@ TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params) {
   const double w = params.image.width, h = params.image.height, f = params.focal_px;
   const cv::Matx33d K(f, 0, w / 2, 0, f, h / 2, 0, 0, 1);
   const cv::Matx33d Kinv = K.inv();
-  const cv::Matx33d R = rotation({between(-0.05, 0.05), between(-0.08, 0.08), between(-0.03, 0.03)});
+  const cv::Matx33d R =
+      rotation({between(-0.05, 0.05), between(-0.08, 0.08), between(-0.03, 0.03)});
   cv::Vec3d t(1.0, between(-0.2, 0.2), between(-0.3, 0.3));
   t *= params.baseline_m / cv::norm(t);
 
@@ -58,7 +58,8 @@ TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params) {
       const cv::Vec3d centre_ray = Kinv * cv::Vec3d((k + 0.5) * strip, h / 2, 1.0);
       const cv::Vec3d centre = between(2.0, 6.0) * centre_ray;
       const double yaw = between(-0.87, 0.87), pitch = between(-0.5, 0.5);
-      n = cv::Vec3d(std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch));
+      n = cv::Vec3d(std::sin(yaw) * std::cos(pitch), std::sin(pitch),
+                    std::cos(yaw) * std::cos(pitch));
       d = n.dot(centre);
       H = K * (R + t * n.t() * (1.0 / d)) * Kinv;
       H *= 1.0 / H(2, 2);
@@ -71,7 +72,8 @@ TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params) {
     }
     scene.homographies.push_back(H);
 
-    for (int made = 0, tries = 0; made < params.points_per_plane && tries < 100 * params.points_per_plane; ++tries) {
+    for (int made = 0, tries = 0;
+         made < params.points_per_plane && tries < 100 * params.points_per_plane; ++tries) {
       const cv::Point2d p1(between(k * strip + 5, (k + 1) * strip - 5), between(5, h - 5));
       const cv::Vec3d ray = Kinv * cv::Vec3d(p1.x, p1.y, 1.0);
       const double depth = d / n.dot(ray);

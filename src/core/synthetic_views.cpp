@@ -1,9 +1,8 @@
 #include "mono_plane_detection/synthetic_views.h"
 
 #include <cmath>
-#include <random>
-
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 namespace mono_plane_detection {
 
@@ -35,8 +34,8 @@ cv::Mat makeCornerTexture(const cv::Size& size, unsigned seed) {
 
 cv::Mat warpView(const cv::Mat& texture, const cv::Matx33d& H, const cv::Size& view_size) {
   cv::Mat view;
-  cv::warpPerspective(texture, view, cv::Mat(H), view_size, cv::INTER_LINEAR,
-                      cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::warpPerspective(texture, view, cv::Mat(H), view_size, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                      cv::Scalar(0));
   return view;
 }
 

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
-#include <vector>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <vector>
 
 namespace mono_plane_detection {
 namespace {
@@ -39,8 +38,8 @@ std::array<cv::Point2f, 4> orderCorners(std::vector<cv::Point> quad) {
 // between its dark and bright levels: the edge between the white rectangle and its
 // black border. (Not the gradient maximum: a magnified, bilinearly sampled edge is a
 // ramp whose gradient is flat across it.) Nothing when the contrast is too weak.
-std::optional<cv::Point2f> edgePoint(const cv::Mat& gray, const cv::Point2f& p, const cv::Point2f& normal,
-                                     int reach) {
+std::optional<cv::Point2f> edgePoint(const cv::Mat& gray, const cv::Point2f& p,
+                                     const cv::Point2f& normal, int reach) {
   std::vector<float> profile;
   for (int k = -reach; k <= reach; ++k) {
     const cv::Point2f q = p + static_cast<float>(k) * normal;
@@ -67,7 +66,8 @@ std::optional<cv::Point2f> edgePoint(const cv::Mat& gray, const cv::Point2f& p, 
 // Corners as intersections of lines fitted (cv::fitLine) to sub-pixel edge points along
 // each side, which uses the whole side rather than a window at the corner. A side with
 // too few edge points keeps its corners as they were.
-std::array<cv::Point2f, 4> refineByEdgeLines(const cv::Mat& gray, const std::array<cv::Point2f, 4>& c) {
+std::array<cv::Point2f, 4> refineByEdgeLines(const cv::Mat& gray,
+                                             const std::array<cv::Point2f, 4>& c) {
   std::array<cv::Vec4f, 4> lines;
   for (int i = 0; i < 4; ++i) {
     const cv::Point2f a = c[i], b = c[(i + 1) % 4];
@@ -79,7 +79,8 @@ std::array<cv::Point2f, 4> refineByEdgeLines(const cv::Mat& gray, const std::arr
     const int samples = static_cast<int>(length);
     for (int s = 0; s <= samples; ++s) {
       const double f = 0.15 + 0.7 * s / samples;  // away from the corners
-      if (auto e = edgePoint(gray, a + static_cast<float>(f * length) * along, normal, 4)) points.push_back(*e);
+      if (auto e = edgePoint(gray, a + static_cast<float>(f * length) * along, normal, 4))
+        points.push_back(*e);
     }
     if (points.size() < 6) return c;
     cv::fitLine(points, lines[i], cv::DIST_HUBER, 0, 0.01, 0.01);
@@ -92,7 +93,8 @@ std::array<cv::Point2f, 4> refineByEdgeLines(const cv::Mat& gray, const std::arr
     const double det = l1[0] * l2[1] - l1[1] * l2[0];
     if (std::abs(det) < 1e-6) return c;
     const double t = ((l2[2] - l1[2]) * l2[1] - (l2[3] - l1[3]) * l2[0]) / det;
-    out[i] = cv::Point2f(static_cast<float>(l1[2] + t * l1[0]), static_cast<float>(l1[3] + t * l1[1]));
+    out[i] =
+        cv::Point2f(static_cast<float>(l1[2] + t * l1[0]), static_cast<float>(l1[3] + t * l1[1]));
     if (cv::norm(out[i] - c[i]) > 3.0) return c;  // a wild fit: keep the contour's corners
   }
   return out;
@@ -102,7 +104,8 @@ std::array<cv::Point2f, 4> refineByEdgeLines(const cv::Mat& gray, const std::arr
 
 std::array<cv::Point3d, 4> targetCornersInMap(const TargetParams& p) {
   const double w = p.width_m / 2, h = p.height_m / 2;
-  return {cv::Point3d(-w, -h, 0), cv::Point3d(w, -h, 0), cv::Point3d(w, h, 0), cv::Point3d(-w, h, 0)};
+  return {cv::Point3d(-w, -h, 0), cv::Point3d(w, -h, 0), cv::Point3d(w, h, 0),
+          cv::Point3d(-w, h, 0)};
 }
 
 TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params) {
@@ -141,16 +144,19 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params) {
     // The whole target, its black border included, must be in view: a bright patch cut
     // by the image edge is not a target, and its corners would be the edge's.
     const int ring = std::max(2, static_cast<int>(0.08 * std::sqrt(area)));
-    const cv::Rect clear(ring + 3, ring + 3, gray.cols - 2 * (ring + 3), gray.rows - 2 * (ring + 3));
+    const cv::Rect clear(ring + 3, ring + 3, gray.cols - 2 * (ring + 3),
+                         gray.rows - 2 * (ring + 3));
     if (clear.width <= 0 || clear.height <= 0 ||
-        std::any_of(quad.begin(), quad.end(), [&](const cv::Point& p) { return !clear.contains(p); })) {
+        std::any_of(quad.begin(), quad.end(),
+                    [&](const cv::Point& p) { return !clear.contains(p); })) {
       continue;
     }
     cv::Mat inside = cv::Mat::zeros(gray.size(), CV_8U), around, margin;
     cv::fillConvexPoly(inside, quad, 255);
     // The ring starts 2 px out, past the edge's blur, and stays within the border
     // (0.05 m of a 0.297 m target: ~17 % of its width).
-    cv::dilate(inside, around, cv::getStructuringElement(cv::MORPH_RECT, {2 * (ring + 2) + 1, 2 * (ring + 2) + 1}));
+    cv::dilate(inside, around,
+               cv::getStructuringElement(cv::MORPH_RECT, {2 * (ring + 2) + 1, 2 * (ring + 2) + 1}));
     cv::dilate(inside, margin, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
     around -= margin;
     cv::Mat core;

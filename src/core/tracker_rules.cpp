@@ -2,7 +2,6 @@
 // image work so they can be tested on hand-made cases.
 #include "mono_plane_detection/feature_tracker.h"
 
-
 namespace mono_plane_detection {
 
 bool shouldSearch(int found_at_last_search, int alive, int frames_since_search,
@@ -32,8 +31,7 @@ std::vector<int> closestClaimWins(const std::vector<int>& claim, const std::vect
 }
 
 std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,
-                                      const std::vector<cv::Point2f>& points,
-                                      double radius_px) {
+                                      const std::vector<cv::Point2f>& points, double radius_px) {
   std::vector<int> nearest(corners.size(), -1);
   std::vector<double> distance2(corners.size(), 0.0);
   const double radius2 = radius_px * radius_px;

@@ -1,8 +1,8 @@
 #include "image_input.h"
 
-#include <sstream>
-
 #include <sensor_msgs/image_encodings.h>
+
+#include <sstream>
 
 namespace mono_plane_detection {
 
@@ -15,8 +15,7 @@ GreyImage toGrey(const sensor_msgs::ImageConstPtr& msg) {
     return out;
   }
   // A malformed message must not make cv_bridge read past the buffer.
-  if (static_cast<uint64_t>(msg->step) * msg->height > msg->data.size() ||
-      msg->step < msg->width) {
+  if (static_cast<uint64_t>(msg->step) * msg->height > msg->data.size() || msg->step < msg->width) {
     std::ostringstream why;
     why << "malformed image: step " << msg->step << " x height " << msg->height
         << " does not fit data of " << msg->data.size() << " bytes";

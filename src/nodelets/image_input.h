@@ -1,10 +1,10 @@
 // Turns an incoming sensor_msgs/Image into an 8-bit grey cv::Mat, or says why not.
 #pragma once
 
-#include <string>
-
 #include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/Image.h>
+
+#include <string>
 
 namespace mono_plane_detection {
 

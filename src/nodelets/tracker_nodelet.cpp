@@ -1,16 +1,16 @@
 // Thin ROS glue around FeatureTracker: image in, Tracks and a debug image out.
-#include <atomic>
-#include <cmath>
-#include <memory>
-#include <mutex>
-
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <pluginlib/class_list_macros.hpp>
 
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
@@ -53,8 +53,8 @@ TrackerParams sanitized(TrackerParams p, const std::string& name) {
   const TrackerParams d;
   auto fix = [&](bool bad, const char* what, auto& value, auto fallback) {
     if (!bad) return;
-    ROS_ERROR_STREAM_NAMED(name, "parameter " << what << " = " << value
-                                              << " is invalid; using " << fallback);
+    ROS_ERROR_STREAM_NAMED(
+        name, "parameter " << what << " = " << value << " is invalid; using " << fallback);
     value = fallback;
   };
   fix(p.max_features < 1, "max_features", p.max_features, d.max_features);
@@ -120,9 +120,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     pnh.param("expected_max_rate_hz", max_rate_, 100.0);
     updater_->add(*rate_diagnostic_);
     updater_->add("tracking", this, &TrackerNodelet::diagnose);
-    diagnostic_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
-      updater_->update();
-    });
+    diagnostic_timer_ =
+        nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
 
     it_ = std::make_unique<image_transport::ImageTransport>(nh);
     std::lock_guard<std::mutex> lock(connect_mutex_);
@@ -145,9 +144,10 @@ class TrackerNodelet : public nodelet::Nodelet {
                         std::isfinite(info->K[4]) && std::isfinite(info->K[2]) &&
                         std::isfinite(info->K[5]) && info->width > 0 && info->height > 0;
     if (!usable) {
-      NODELET_WARN_THROTTLE(10.0, "camera_info has unusable intrinsics (fx=%g fy=%g, %ux%u): "
-                            "ignored, tracking goes on in pixels", info->K[0], info->K[4],
-                            info->width, info->height);
+      NODELET_WARN_THROTTLE(10.0,
+                            "camera_info has unusable intrinsics (fx=%g fy=%g, %ux%u): "
+                            "ignored, tracking goes on in pixels",
+                            info->K[0], info->K[4], info->width, info->height);
     }
     std::lock_guard<std::mutex> lock(state_mutex_);
     info_size_ = usable ? cv::Size(info->width, info->height) : cv::Size();
@@ -183,9 +183,10 @@ class TrackerNodelet : public nodelet::Nodelet {
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
       if (!last_stamp_.isZero() && msg->header.stamp < last_stamp_) {
-        NODELET_WARN("image stamp %.3f is before the previous one (%.3f): time went "
-                     "backwards (bag loop?), tracking starts over",
-                     msg->header.stamp.toSec(), last_stamp_.toSec());
+        NODELET_WARN(
+            "image stamp %.3f is before the previous one (%.3f): time went "
+            "backwards (bag loop?), tracking starts over",
+            msg->header.stamp.toSec(), last_stamp_.toSec());
         tracker_.reset();
       }
       last_stamp_ = msg->header.stamp;

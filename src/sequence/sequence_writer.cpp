@@ -1,17 +1,17 @@
 #include "sequence_writer.h"
 
-#include <chrono>
-#include <cmath>
-#include <fstream>
-#include <stdexcept>
-
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgproc.hpp>
 #include <rosbag/bag.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 #include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 namespace mono_plane_detection {
 namespace {
@@ -63,11 +63,13 @@ void validate(const SequenceSpec& spec) {
     throw std::runtime_error("exposure swing must be in [0, 1)");
   if (spec.encoding != "mono8" && spec.encoding != "bgr8")
     throw std::runtime_error("encoding must be mono8 or bgr8, not '" + spec.encoding + "'");
-  if (spec.camera.size.width < 1 || spec.camera.size.height < 1 || !(spec.camera.fx > 0) || !(spec.camera.fy > 0))
+  if (spec.camera.size.width < 1 || spec.camera.size.height < 1 || !(spec.camera.fx > 0) ||
+      !(spec.camera.fy > 0))
     throw std::runtime_error("camera size and focal lengths must be positive");
   const std::string& name = spec.trajectory.name;
   if (name != "wheeled" && name != "humanoid" && name != "rotation")
-    throw std::runtime_error("trajectory must be wheeled, humanoid or rotation, not '" + name + "'");
+    throw std::runtime_error("trajectory must be wheeled, humanoid or rotation, not '" + name +
+                             "'");
 }
 
 void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const std::string& path) {
@@ -89,13 +91,15 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
   camera["k1"] = spec.camera.k1;
   camera["k2"] = spec.camera.k2;
   root["camera"] = camera;
-  root["map_frame"] = "origin at the target centre; x along the target's width, y along its "
-                      "height, z = x cross y out of the target into the room (metres)";
+  root["map_frame"] =
+      "origin at the target centre; x along the target's width, y along its "
+      "height, z = x cross y out of the target into the room (metres)";
   YAML::Node target;
   target["width_m"] = scene.target.width_m;
   target["height_m"] = scene.target.height_m;
   target["plane_id"] = scene.planes[scene.target.plane_index].id;
-  for (const auto& c : scene.target.corners) target["corners_map"].push_back(vec(map_from_world.apply(c)));
+  for (const auto& c : scene.target.corners)
+    target["corners_map"].push_back(vec(map_from_world.apply(c)));
   root["target"] = target;
   for (const auto& p : scene.planes) {
     YAML::Node plane;
@@ -119,7 +123,8 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
   }
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
-  out << "# Ground truth of a synthetic sequence (mono_plane_detection make_sequence)\n" << root << "\n";
+  out << "# Ground truth of a synthetic sequence (mono_plane_detection make_sequence)\n"
+      << root << "\n";
 }
 
 }  // namespace
@@ -129,7 +134,8 @@ Pose groundTruthPose(const SequenceSpec& spec, const IndoorScene& scene, int k) 
 }
 
 SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_path,
-                             const std::string& yaml_path, const std::function<void(int)>& progress) {
+                             const std::string& yaml_path,
+                             const std::function<void(int)>& progress) {
   validate(spec);
   const IndoorScene scene = makeRoom(spec.room);
   const SceneRenderer renderer(scene, spec.camera, spec.render);
@@ -151,16 +157,19 @@ SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_pa
     // Motion blur: the poses over half an image period before the stamp.
     std::vector<Pose> poses;
     for (int s = 0; s < subframes; ++s) {
-      const double dt = subframes > 1 ? -0.5 / spec.fps * (subframes - 1 - s) / (subframes - 1) : 0.0;
+      const double dt =
+          subframes > 1 ? -0.5 / spec.fps * (subframes - 1 - s) / (subframes - 1) : 0.0;
       poses.push_back(trajectoryPose(spec.trajectory, std::max(0.0, t + dt)));
     }
     const auto start = std::chrono::steady_clock::now();
     const double gain = 1.0 + spec.exposure_swing * std::sin(2 * CV_PI * t / 4.0);
     cv::Mat image = renderer.renderBlurred(poses, static_cast<unsigned>(k), gain);
-    render_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    render_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (spec.encoding == "bgr8") cv::cvtColor(image, image, cv::COLOR_GRAY2BGR);
 
-    bag.write(spec.image_topic, header.stamp, cv_bridge::CvImage(header, spec.encoding, image).toImageMsg());
+    bag.write(spec.image_topic, header.stamp,
+              cv_bridge::CvImage(header, spec.encoding, image).toImageMsg());
     bag.write(spec.info_topic, header.stamp, cameraInfo(spec, header));
 
     const Pose gt = groundTruthPose(spec, scene, k);

@@ -18,13 +18,14 @@ struct SequenceSpec {
   TrajectoryParams trajectory;
   int frames = 300;
   double fps = 30;
-  std::string encoding = "mono8";             // mono8 | bgr8
-  std::string frame_id = "camera_optical";    // of images and camera_info
+  std::string encoding = "mono8";           // mono8 | bgr8
+  std::string frame_id = "camera_optical";  // of images and camera_info
   std::string image_topic = "/camera/image_raw";
   std::string info_topic = "/camera/camera_info";
-  std::string map_frame = "map", ground_truth_frame = "camera_gt";  // tf published as map -> camera_gt
-  double start_time_s = 1000.0;               // stamp of the first image
-  double exposure_swing = 0.0;                // exposure varies by +- this share, 4 s period
+  std::string map_frame = "map",
+              ground_truth_frame = "camera_gt";  // tf published as map -> camera_gt
+  double start_time_s = 1000.0;                  // stamp of the first image
+  double exposure_swing = 0.0;                   // exposure varies by +- this share, 4 s period
 };
 
 struct SequenceReport {

@@ -8,10 +8,9 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "mono_plane_detection/feature_tracker.h"
 #include "mono_plane_detection/synthetic_views.h"
@@ -32,11 +31,14 @@ const cv::Point2d kPivot(500, 400);  // texture centre
 
 std::vector<Motion> motions() {
   return {
-      {"easy", [](int k) { return similarity(0.002 * k, kPivot, kCentred + k * cv::Point2d(1.3, -0.7)); }},
-      {"fast", [](int k) { return similarity(0.004 * k, kPivot, kCentred + k * cv::Point2d(6.0, 1.5)); }},
+      {"easy",
+       [](int k) { return similarity(0.002 * k, kPivot, kCentred + k * cv::Point2d(1.3, -0.7)); }},
+      {"fast",
+       [](int k) { return similarity(0.004 * k, kPivot, kCentred + k * cv::Point2d(6.0, 1.5)); }},
       // A walking robot's head: forward drift, step bob (~12 px at 2 Hz / 30 fps),
       // sway, roll wobble and a jerk every 25 images.
-      {"humanoid", [](int k) {
+      {"humanoid",
+       [](int k) {
          const double phase = 2 * CV_PI * k / 15.0;
          const double jerk = (k % 25 == 0 && k > 0) ? 10.0 : 0.0;
          const cv::Point2d bob(4.0 * std::sin(phase / 2) + jerk, 12.0 * std::sin(phase));
@@ -65,7 +67,9 @@ Result run(const TrackerParams& params, const Motion& motion, const cv::Mat& tex
     cv::Mat(view + noise).convertTo(view, CV_8U);  // saturates
     const auto start = std::chrono::steady_clock::now();
     const auto& points = tracker.process(view);
-    times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    times.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     followed += tracker.previous().size();
     tracked += tracker.lastStats().tracked;
     score.observe(points, H);
@@ -80,13 +84,13 @@ Result run(const TrackerParams& params, const Motion& motion, const cv::Mat& tex
 }
 
 void printRow(const std::string& label, const Result& r) {
-  std::printf("  %-34s %8.3f %8.3f %9.1f%% %8.2f %8.2f\n", label.c_str(), r.mean_error,
-              r.p95_error, 100.0 * r.survival, r.mean_ms, r.p95_ms);
+  std::printf("  %-34s %8.3f %8.3f %9.1f%% %8.2f %8.2f\n", label.c_str(), r.mean_error, r.p95_error,
+              100.0 * r.survival, r.mean_ms, r.p95_ms);
 }
 
 void printHeader(const char* title) {
-  std::printf("\n%s\n  %-34s %8s %8s %10s %8s %8s\n", title, "", "err px", "p95 px",
-              "kept/img", "ms", "p95 ms");
+  std::printf("\n%s\n  %-34s %8s %8s %10s %8s %8s\n", title, "", "err px", "p95 px", "kept/img",
+              "ms", "p95 ms");
 }
 
 }  // namespace
@@ -103,10 +107,12 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);  // one core, as on the robot's budget
   const cv::Mat texture = makeCornerTexture({1400, 1100}, 42);
   const cv::Size vga(640, 480);
-  std::printf("benchmark_tracker: %d generated images per row, 640x480 unless stated, one thread.\n"
-              "err = distance of a tracked point from where its texture pixel truly is,\n"
-              "kept/img = share of points followed from one image to the next.\n"
-              "Views carry Gaussian sensor noise of %.0f grey levels.\n", frames, kSensorNoise);
+  std::printf(
+      "benchmark_tracker: %d generated images per row, 640x480 unless stated, one thread.\n"
+      "err = distance of a tracked point from where its texture pixel truly is,\n"
+      "kept/img = share of points followed from one image to the next.\n"
+      "Views carry Gaussian sensor noise of %.0f grey levels.\n",
+      frames, kSensorNoise);
 
   printHeader("LK window size (50 features, all switches on)");
   for (const Motion& m : motions()) {
@@ -122,7 +128,8 @@ int main(int argc, char** argv) {
     TrackerParams p;
     p.max_features = n;
     p.min_distance_px = n > 50 ? 10.0 : 15.0;
-    printRow("easy  " + std::to_string(n) + " features", run(p, motions()[0], texture, vga, frames));
+    printRow("easy  " + std::to_string(n) + " features",
+             run(p, motions()[0], texture, vga, frames));
   }
 
   printHeader("Beyond-the-paper switches (humanoid motion, 50 features)");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "../sequence/sequence_writer.h"
+#include "cli_args.h"
 
 using namespace mono_plane_detection;
 
@@ -28,20 +29,10 @@ const char* kUsage =
     "  --yaml FILE [next to the bag]   --quiet   --help\n"
     "exit codes: 0 done, 2 bad usage, 1 could not write\n";
 
-int usageError(const std::string& what) {
-  std::fprintf(stderr, "make_sequence: %s\n%s", what.c_str(), kUsage);
-  return 2;
-}
-
-bool number(const char* text, double& out) {
-  char* end = nullptr;
-  out = std::strtod(text, &end);
-  return end && *end == '\0' && out == out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
+  auto fail = [](const std::string& what) { return usageError("make_sequence", what, kUsage); };
   SequenceSpec spec;
   std::string bag_path, yaml_path;
   bool quiet = false;
@@ -51,48 +42,76 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return 0;
     }
-    if (arg == "--quiet") { quiet = true; continue; }
-    if (arg == "--no-ceiling") { spec.room.ceiling = false; continue; }
-    if (i + 1 >= argc) return usageError(arg + " needs a value");
+    if (arg == "--quiet") {
+      quiet = true;
+      continue;
+    }
+    if (arg == "--no-ceiling") {
+      spec.room.ceiling = false;
+      continue;
+    }
+    if (i + 1 >= argc) return fail(arg + " needs a value");
     const std::string value = argv[++i];
     double x = 0;
-    const bool numeric = number(value.c_str(), x);
+    const bool numeric = parseNumber(value.c_str(), x);
     auto positive = [&](const char* what) {
-      if (!numeric || !(x > 0)) throw std::invalid_argument(std::string(what) + " needs a positive number");
+      if (!numeric || !(x > 0))
+        throw std::invalid_argument(std::string(what) + " needs a positive number");
       return x;
     };
     try {
-      if (arg == "--out") bag_path = value;
-      else if (arg == "--yaml") yaml_path = value;
-      else if (arg == "--trajectory") spec.trajectory.name = value;
-      else if (arg == "--encoding") spec.encoding = value;
-      else if (arg == "--target") spec.room.target_on = value;
-      else if (arg == "--frames") spec.frames = static_cast<int>(positive("--frames"));
-      else if (arg == "--fps") spec.fps = positive("--fps");
-      else if (arg == "--speed") spec.trajectory.speed_mps = numeric ? x : positive("--speed");
-      else if (arg == "--turn") spec.trajectory.turn_deg = numeric ? x : positive("--turn");
-      else if (arg == "--seed") spec.room.seed = spec.trajectory.seed = static_cast<unsigned>(positive("--seed"));
-      else if (arg == "--width") spec.camera.size.width = static_cast<int>(positive("--width"));
-      else if (arg == "--height") spec.camera.size.height = static_cast<int>(positive("--height"));
-      else if (arg == "--focal") spec.camera.fx = spec.camera.fy = positive("--focal");
-      else if (arg == "--k1") spec.camera.k1 = numeric ? x : positive("--k1");
-      else if (arg == "--k2") spec.camera.k2 = numeric ? x : positive("--k2");
-      else if (arg == "--noise") spec.render.noise_sigma = numeric && x >= 0 ? x : positive("--noise");
-      else if (arg == "--blur") spec.render.blur_subframes = static_cast<int>(positive("--blur"));
-      else if (arg == "--supersample") spec.render.supersample = static_cast<int>(positive("--supersample"));
-      else if (arg == "--exposure") spec.render.exposure = positive("--exposure");
-      else if (arg == "--exposure-swing") spec.exposure_swing = numeric ? x : positive("--exposure-swing");
+      if (arg == "--out")
+        bag_path = value;
+      else if (arg == "--yaml")
+        yaml_path = value;
+      else if (arg == "--trajectory")
+        spec.trajectory.name = value;
+      else if (arg == "--encoding")
+        spec.encoding = value;
+      else if (arg == "--target")
+        spec.room.target_on = value;
+      else if (arg == "--frames")
+        spec.frames = static_cast<int>(positive("--frames"));
+      else if (arg == "--fps")
+        spec.fps = positive("--fps");
+      else if (arg == "--speed")
+        spec.trajectory.speed_mps = numeric ? x : positive("--speed");
+      else if (arg == "--turn")
+        spec.trajectory.turn_deg = numeric ? x : positive("--turn");
+      else if (arg == "--seed")
+        spec.room.seed = spec.trajectory.seed = static_cast<unsigned>(positive("--seed"));
+      else if (arg == "--width")
+        spec.camera.size.width = static_cast<int>(positive("--width"));
+      else if (arg == "--height")
+        spec.camera.size.height = static_cast<int>(positive("--height"));
+      else if (arg == "--focal")
+        spec.camera.fx = spec.camera.fy = positive("--focal");
+      else if (arg == "--k1")
+        spec.camera.k1 = numeric ? x : positive("--k1");
+      else if (arg == "--k2")
+        spec.camera.k2 = numeric ? x : positive("--k2");
+      else if (arg == "--noise")
+        spec.render.noise_sigma = numeric && x >= 0 ? x : positive("--noise");
+      else if (arg == "--blur")
+        spec.render.blur_subframes = static_cast<int>(positive("--blur"));
+      else if (arg == "--supersample")
+        spec.render.supersample = static_cast<int>(positive("--supersample"));
+      else if (arg == "--exposure")
+        spec.render.exposure = positive("--exposure");
+      else if (arg == "--exposure-swing")
+        spec.exposure_swing = numeric ? x : positive("--exposure-swing");
       else if (arg == "--walls") {
-        if (!numeric || x < 0 || x > 4) return usageError("--walls needs 0 to 4");
+        if (!numeric || x < 0 || x > 4) return fail("--walls needs 0 to 4");
         spec.room.walls = static_cast<int>(x);
-      } else return usageError("unknown option " + arg);
+      } else
+        return fail("unknown option " + arg);
     } catch (const std::invalid_argument& e) {
-      return usageError(e.what());
+      return fail(e.what());
     }
   }
-  if (bag_path.empty()) return usageError("--out FILE.bag is required");
+  if (bag_path.empty()) return fail("--out FILE.bag is required");
   if (spec.room.target_on != "wall" && spec.room.target_on != "floor")
-    return usageError("--target must be wall or floor");
+    return fail("--target must be wall or floor");
   spec.camera.cx = (spec.camera.size.width - 1) / 2.0;
   spec.camera.cy = (spec.camera.size.height - 1) / 2.0;
   if (yaml_path.empty()) {
@@ -107,9 +126,11 @@ int main(int argc, char** argv) {
     });
     if (!quiet) {
       std::fprintf(stderr, "\n");
-      std::printf("wrote %s (%d images, %s trajectory) and %s; rendering %.1f ms per image "
-                  "(%.0f images/s)\n", bag_path.c_str(), report.frames, spec.trajectory.name.c_str(),
-                  yaml_path.c_str(), report.render_ms_mean, 1000.0 / report.render_ms_mean);
+      std::printf(
+          "wrote %s (%d images, %s trajectory) and %s; rendering %.1f ms per image "
+          "(%.0f images/s)\n",
+          bag_path.c_str(), report.frames, spec.trajectory.name.c_str(), yaml_path.c_str(),
+          report.render_ms_mean, 1000.0 / report.render_ms_mean);
     }
   } catch (const std::runtime_error& e) {
     std::fprintf(stderr, "make_sequence: %s\n", e.what());

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <string>
 
+#include "cli_args.h"
 #include "mono_plane_detection/correspondence_io.h"
 #include "mono_plane_detection/homography_voting.h"
 
@@ -33,33 +34,19 @@ const char* kUsage =
     "  --help             this text\n"
     "exit codes: 0 done (fewer than 5 points: all labels 0), 2 bad usage or input\n";
 
-int usageError(const std::string& what) {
-  std::fprintf(stderr, "segment_planes: %s\n%s", what.c_str(), kUsage);
-  return 2;
-}
-
-bool parseDouble(const char* text, double& out) {
-  char* end = nullptr;
-  out = std::strtod(text, &end);
-  return end && *end == '\0' && out == out;
-}
-
-bool parseInt(const char* text, long& out) {
-  char* end = nullptr;
-  out = std::strtol(text, &end, 10);
-  return end && *end == '\0';
-}
-
 void printJson(const PlaneSegmentation& result, size_t points) {
-  std::printf("{\n  \"points\": %zu,\n  \"groups_built\": %d,\n  \"groups_coplanar\": %d,\n  \"planes\": [",
-              points, result.groups_built, result.groups_coplanar);
+  std::printf(
+      "{\n  \"points\": %zu,\n  \"groups_built\": %d,\n  \"groups_coplanar\": %d,\n  \"planes\": [",
+      points, result.groups_built, result.groups_coplanar);
   for (size_t k = 0; k < result.planes.size(); ++k) {
     const Plane& p = result.planes[k];
-    std::printf("%s\n    {\"id\": %zu, \"support\": %zu, \"score\": %.6f, \"rms_error_px\": %.6f,\n"
-                "     \"homography\": [[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g]],\n"
-                "     \"inliers\": [",
-                k ? "," : "", k + 1, p.inliers.size(), p.score, p.rms_error_px, p.H(0, 0), p.H(0, 1),
-                p.H(0, 2), p.H(1, 0), p.H(1, 1), p.H(1, 2), p.H(2, 0), p.H(2, 1), p.H(2, 2));
+    std::printf(
+        "%s\n    {\"id\": %zu, \"support\": %zu, \"score\": %.6f, \"rms_error_px\": %.6f,\n"
+        "     \"homography\": [[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g], [%.10g, %.10g, "
+        "%.10g]],\n"
+        "     \"inliers\": [",
+        k ? "," : "", k + 1, p.inliers.size(), p.score, p.rms_error_px, p.H(0, 0), p.H(0, 1),
+        p.H(0, 2), p.H(1, 0), p.H(1, 1), p.H(1, 2), p.H(2, 0), p.H(2, 1), p.H(2, 2));
     for (size_t i = 0; i < p.inliers.size(); ++i) std::printf("%s%d", i ? ", " : "", p.inliers[i]);
     std::printf("]}");
   }
@@ -69,6 +56,7 @@ void printJson(const PlaneSegmentation& result, size_t points) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  auto fail = [](const std::string& what) { return usageError("segment_planes", what, kUsage); };
   PlaneParams params;
   bool json = false;
   std::string path;
@@ -84,33 +72,36 @@ int main(int argc, char** argv) {
       json = true;
     } else if (arg == "--threshold") {
       const char* v = value();
-      if (!v || !parseDouble(v, d) || d <= 0) return usageError("--threshold needs a positive number of pixels");
+      if (!v || !parseNumber(v, d) || d <= 0)
+        return fail("--threshold needs a positive number of pixels");
       params.vote_threshold_px = d;
     } else if (arg == "--invariant-threshold") {
       const char* v = value();
-      if (!v || !parseDouble(v, d) || d <= 0) return usageError("--invariant-threshold needs a positive number");
+      if (!v || !parseNumber(v, d) || d <= 0)
+        return fail("--invariant-threshold needs a positive number");
       params.groups.invariant_threshold = d;
     } else if (arg == "--max-planes") {
       const char* v = value();
-      if (!v || !parseInt(v, n) || n < 1) return usageError("--max-planes needs a whole number >= 1");
+      if (!v || !parseInteger(v, n) || n < 1) return fail("--max-planes needs a whole number >= 1");
       params.max_planes = static_cast<int>(n);
     } else if (arg == "--min-support") {
       const char* v = value();
-      if (!v || !parseInt(v, n) || n < 4) return usageError("--min-support needs a whole number >= 4");
+      if (!v || !parseInteger(v, n) || n < 4)
+        return fail("--min-support needs a whole number >= 4");
       params.min_plane_support = static_cast<int>(n);
     } else if (arg == "--seed") {
       const char* v = value();
-      if (!v || !parseInt(v, n) || n < 0) return usageError("--seed needs a whole number >= 0");
+      if (!v || !parseInteger(v, n) || n < 0) return fail("--seed needs a whole number >= 0");
       params.groups.seed = static_cast<unsigned>(n);
     } else if (arg.size() > 1 && arg[0] == '-' && arg != "-") {
-      return usageError("unknown option " + arg);
+      return fail("unknown option " + arg);
     } else if (path.empty()) {
       path = arg;
     } else {
-      return usageError("more than one input file");
+      return fail("more than one input file");
     }
   }
-  if (path.empty()) return usageError("no input file");
+  if (path.empty()) return fail("no input file");
 
   Correspondences input;
   if (path == "-") {
