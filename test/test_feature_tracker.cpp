@@ -254,3 +254,28 @@ TEST(FeatureTracker, ResetKeepsIdsIncreasing) {
   EXPECT_TRUE(tracker.current().empty());
   for (const auto& p : tracker.process(view)) EXPECT_GT(p.id, highest);
 }
+
+TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
+  FeatureTracker tracker;
+  const auto hs = translations(6, kCentred, {1.0, 0.5});
+  tracker.process(warpView(texture(), hs[0], kView));
+  // Four texture corners stand in for the target's.
+  std::vector<cv::Point2f> corners;
+  for (int i = 0; i < 4; ++i) corners.push_back(tracker.current()[i * 5].uv + cv::Point2f(0.f, 0.f));
+  const auto ids = tracker.addPoints(corners, true);
+  ASSERT_EQ(ids.size(), 4u);
+  for (auto id : ids) EXPECT_GT(id, tracker.current().front().id);
+  EXPECT_EQ(tracker.addPoints({{-5.f, 10.f}}, true).size(), 0u);  // outside the image
+  for (size_t k = 1; k < hs.size(); ++k) {
+    const auto& points = tracker.process(warpView(texture(), hs[k], kView));
+    int flagged = 0;
+    for (const auto& p : points) {
+      if (!p.is_target_corner) continue;
+      ++flagged;
+      EXPECT_TRUE(p.is_tracked);
+      const cv::Point2d truth = transfer(hs[k] * hs[0].inv(), cv::Point2d(corners[flagged - 1]));
+      EXPECT_LT(cv::norm(truth - cv::Point2d(p.uv)), 0.3);
+    }
+    EXPECT_EQ(flagged, 4) << "image " << k;
+  }
+}

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/scene_renderer.h"
 #include "mono_plane_detection/synthetic_views.h"
 
 using namespace mono_plane_detection;
@@ -255,6 +256,30 @@ TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
       coloured += (p[0] != p[1] || p[1] != p[2]);
     }
   EXPECT_GT(coloured, 500);
+}
+
+// Last: the target's corners stay tracked for the rest of the node's life.
+TEST_F(TrackerNodeletTest, StartUpTargetCornersAreFlaggedAndTracked) {
+  const IndoorScene scene = makeRoom(RoomParams());
+  const CameraModel camera;
+  const SceneRenderer renderer(scene, camera, RenderOptions());
+  TrajectoryParams path;
+  for (int k = 0; k < 3; ++k) {
+    const Pose pose = trajectoryPose(path, k / 30.0);
+    auto tracks = send(makeImage(renderer.render(pose), "mono8", stamp_ += 1.0 / 30));
+    ASSERT_TRUE(tracks);
+    std::vector<cv::Point2d> flagged;
+    for (size_t i = 0; i < tracks->id.size(); ++i) {
+      if (!(tracks->flags[i] & Tracks::FLAG_TARGET_CORNER)) continue;
+      flagged.emplace_back(tracks->u[i], tracks->v[i]);
+      EXPECT_TRUE(tracks->flags[i] & (k == 0 ? Tracks::FLAG_NEW : Tracks::FLAG_TRACKED));
+    }
+    ASSERT_EQ(flagged.size(), 4u) << "image " << k;
+    for (int c = 0; c < 4; ++c) {
+      const cv::Point2d truth = camera.project(pose.inverse().apply(scene.target.corners[c]));
+      EXPECT_LT(cv::norm(flagged[c] - truth), 0.5) << "corner " << c << " image " << k;
+    }
+  }
 }
 
 }  // namespace

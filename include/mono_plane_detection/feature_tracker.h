@@ -57,6 +57,7 @@ struct TrackedPoint {
   bool is_new = false;           // found by the search on this image
   bool is_tracked = false;       // followed by Lucas-Kanade from the previous image
   bool is_reidentified = false;  // new corner that got back the id of a lost point
+  bool is_target_corner = false; // a corner of the start-up target (paper II-A)
   int prev_index = -1;           // index in the previous state, -1 if new
   int age = 0;                   // images since the point was first seen (0 when new)
 };
@@ -95,6 +96,11 @@ class FeatureTracker {
   // otherwise) and returns the new current state. An image of another size than the
   // previous one starts over (reset).
   const std::vector<TrackedPoint>& process(const cv::Mat& gray);
+
+  // Adds points found by other means on the image just processed (the start-up target's
+  // corners): new ids, flagged new (and target_corner), tracked from the next image on.
+  // Returns their ids. Call after process().
+  std::vector<std::uint64_t> addPoints(const std::vector<cv::Point2f>& uv, bool target_corner);
 
   // Forgets every point and image; ids keep increasing so they are never reused.
   void reset();

@@ -85,6 +85,23 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   return current_;
 }
 
+std::vector<std::uint64_t> FeatureTracker::addPoints(const std::vector<cv::Point2f>& uv,
+                                                     bool target_corner) {
+  std::vector<std::uint64_t> ids;
+  for (const auto& p : uv) {
+    if (!inside(p, image_size_)) continue;
+    TrackedPoint point;
+    point.id = next_id_++;
+    point.uv = p;
+    point.is_new = true;
+    point.is_target_corner = target_corner;
+    current_.push_back(point);
+    ids.push_back(point.id);
+    ++stats_.added;
+  }
+  return ids;
+}
+
 void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
   if (previous_.empty() || previous_pyramid_.empty()) return;
   const cv::Size window(params_.window_size_px, params_.window_size_px);
@@ -124,7 +141,7 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, cons
     p.uv = after[i];
     p.is_new = false;
     p.is_tracked = true;
-    p.is_reidentified = false;
+    p.is_reidentified = false;  // (is_target_corner stays: it is the same point)
     p.prev_index = static_cast<int>(i);
     ++p.age;
     current_.push_back(p);

@@ -16,6 +16,7 @@
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/draw_tracks.h"
 #include "mono_plane_detection/feature_tracker.h"
+#include "mono_plane_detection/target_detector.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -89,7 +90,8 @@ TracksPtr toMessage(const std_msgs::Header& header, const cv::Size& size,
     msg->prev_index.push_back(p.prev_index);
     msg->flags.push_back((p.is_new ? Tracks::FLAG_NEW : 0) |
                          (p.is_tracked ? Tracks::FLAG_TRACKED : 0) |
-                         (p.is_reidentified ? Tracks::FLAG_REIDENTIFIED : 0));
+                         (p.is_reidentified ? Tracks::FLAG_REIDENTIFIED : 0) |
+                         (p.is_target_corner ? Tracks::FLAG_TARGET_CORNER : 0));
     msg->age.push_back(p.age);
   }
   return msg;
@@ -110,6 +112,9 @@ class TrackerNodelet : public nodelet::Nodelet {
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     tracker_ = FeatureTracker(sanitized(readParams(pnh), getName()));
     pnh.param("lazy", lazy_, true);
+    pnh.param("detect_target", detect_target_, true);
+    pnh.param("target_width_m", target_params_.width_m, target_params_.width_m);
+    pnh.param("target_height_m", target_params_.height_m, target_params_.height_m);
     pnh.param<std::string>("image_transport", transport_, "raw");
 
     updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
@@ -166,6 +171,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       info_sub_.shutdown();
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       tracker_.reset();
+      target_found_ = false;
       last_stamp_ = ros::Time();
     }
   }
@@ -188,14 +194,28 @@ class TrackerNodelet : public nodelet::Nodelet {
             "backwards (bag loop?), tracking starts over",
             msg->header.stamp.toSec(), last_stamp_.toSec());
         tracker_.reset();
+        target_found_ = false;
       }
+      if (grey.image->image.size() != last_size_) target_found_ = false;  // the tracker resets too
+      last_size_ = grey.image->image.size();
       last_stamp_ = msg->header.stamp;
       if (!info_size_.empty() && info_size_ != grey.image->image.size()) {
         NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but the image is %dx%d",
                               info_size_.width, info_size_.height, grey.image->image.cols,
                               grey.image->image.rows);
       }
-      points = tracker_.process(grey.image->image);
+      tracker_.process(grey.image->image);
+      // Paper II-A: until the start-up target is seen, look for it; its corners become
+      // tracked points flagged as target corners.
+      if (detect_target_ && !target_found_) {
+        const TargetDetection target = detectTarget(grey.image->image, target_params_);
+        if (target.found) {
+          tracker_.addPoints({target.corners.begin(), target.corners.end()}, true);
+          target_found_ = true;
+          NODELET_INFO("start-up target found (%.0f grey levels of contrast)", target.contrast);
+        }
+      }
+      points = tracker_.current();
       const TrackerFrameStats& stats = tracker_.lastStats();
       searches_ += stats.searched ? 1 : 0;
       lost_ += stats.lost;
@@ -220,6 +240,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("searches (total)", searches_);
     status.add("images dropped (total)", static_cast<long>(dropped_));
     status.add("camera_info", info_size_.empty() ? "none or unusable" : "ok");
+    status.add("start-up target", !detect_target_ ? "not searched" : target_found_ ? "found" : "waiting");
   }
 
   FeatureTracker tracker_;
@@ -239,6 +260,10 @@ class TrackerNodelet : public nodelet::Nodelet {
   long searches_ = 0;
   int tracked_now_ = 0;
   cv::Size info_size_;  // size of the last usable camera_info, empty when none
+  bool detect_target_ = true;
+  TargetParams target_params_;
+  bool target_found_ = false;
+  cv::Size last_size_;
 
   double min_rate_ = 5.0, max_rate_ = 100.0;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
