@@ -62,6 +62,7 @@ struct PlaneSegmentation {
   std::vector<int> labels;    // per point: 0 = no plane, k >= 1 = planes[k-1]
   int groups_built = 0;       // five-point groups tried (built and tested)
   int groups_coplanar = 0;    // of those, accepted by the invariant test
+  std::vector<PointGroup> accepted_groups;  // those groups (drawn in debug images)
   std::string error;          // why nothing could be done (sizes differ, ...)
 };
 

@@ -39,6 +39,7 @@ std::vector<cv::Matx33d> coplanarGroupHomographies(const std::vector<cv::Point2d
   const CoplanarGroups found = findCoplanarGroups(view1, view2, params);
   out.groups_built = found.tried;
   out.groups_coplanar = static_cast<int>(found.groups.size());
+  out.accepted_groups = found.groups;
   std::vector<cv::Matx33d> homographies;
   for (const PointGroup& g : found.groups) {
     const std::vector<int> idx(g.begin(), g.end());

@@ -16,7 +16,7 @@
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/draw_tracks.h"
 #include "mono_plane_detection/feature_tracker.h"
-#include "mono_plane_detection/target_detector.h"
+#include "mono_plane_detection/target_startup.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -115,6 +115,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     pnh.param("detect_target", detect_target_, true);
     pnh.param("target_width_m", target_params_.width_m, target_params_.width_m);
     pnh.param("target_height_m", target_params_.height_m, target_params_.height_m);
+    target_startup_ = TargetStartup(target_params_);
     pnh.param<std::string>("image_transport", transport_, "raw");
 
     updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
@@ -171,7 +172,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       info_sub_.shutdown();
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       tracker_.reset();
-      target_found_ = false;
+      target_startup_.reset();
       last_stamp_ = ros::Time();
     }
   }
@@ -194,9 +195,9 @@ class TrackerNodelet : public nodelet::Nodelet {
             "backwards (bag loop?), tracking starts over",
             msg->header.stamp.toSec(), last_stamp_.toSec());
         tracker_.reset();
-        target_found_ = false;
+        target_startup_.reset();
       }
-      if (grey.image->image.size() != last_size_) target_found_ = false;  // the tracker resets too
+      if (grey.image->image.size() != last_size_) target_startup_.reset();  // the tracker resets too
       last_size_ = grey.image->image.size();
       last_stamp_ = msg->header.stamp;
       if (!info_size_.empty() && info_size_ != grey.image->image.size()) {
@@ -207,13 +208,9 @@ class TrackerNodelet : public nodelet::Nodelet {
       tracker_.process(grey.image->image);
       // Paper II-A: until the start-up target is seen, look for it; its corners become
       // tracked points flagged as target corners.
-      if (detect_target_ && !target_found_) {
-        const TargetDetection target = detectTarget(grey.image->image, target_params_);
-        if (target.found) {
-          tracker_.addPoints({target.corners.begin(), target.corners.end()}, true);
-          target_found_ = true;
-          NODELET_INFO("start-up target found (%.0f grey levels of contrast)", target.contrast);
-        }
+      if (detect_target_) {
+        if (const auto target = target_startup_.process(grey.image->image, tracker_))
+          NODELET_INFO("start-up target found (%.0f grey levels of contrast)", target->contrast);
       }
       points = tracker_.current();
       const TrackerFrameStats& stats = tracker_.lastStats();
@@ -240,7 +237,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("searches (total)", searches_);
     status.add("images dropped (total)", static_cast<long>(dropped_));
     status.add("camera_info", info_size_.empty() ? "none or unusable" : "ok");
-    status.add("start-up target", !detect_target_ ? "not searched" : target_found_ ? "found" : "waiting");
+    status.add("start-up target", !detect_target_ ? "not searched" : target_startup_.found() ? "found" : "waiting");
   }
 
   FeatureTracker tracker_;
@@ -262,7 +259,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   cv::Size info_size_;  // size of the last usable camera_info, empty when none
   bool detect_target_ = true;
   TargetParams target_params_;
-  bool target_found_ = false;
+  TargetStartup target_startup_;
   cv::Size last_size_;
 
   double min_rate_ = 5.0, max_rate_ = 100.0;

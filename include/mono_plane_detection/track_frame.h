@@ -1,0 +1,31 @@
+// One image's tracked points as the plane stage sees them (the content of a Tracks
+// message without ROS), and the check that rejects malformed input. ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace mono_plane_detection {
+
+struct TrackFrame {
+  double stamp = 0;  // s
+  cv::Size size;     // source image, pixels
+  std::vector<std::uint64_t> ids;
+  std::vector<cv::Point2d> pixels;
+  std::vector<bool> target_corner;  // corner of the start-up target
+};
+
+// Empty when the frame is usable; otherwise why not (array lengths differ, a coordinate
+// is not finite or outside the image, an id repeats, the image size is zero).
+std::string validateTrackFrame(const TrackFrame& frame);
+
+// Pixel pairs of the points seen in both frames, matched by track id, with the ids.
+struct Correspondences {
+  std::vector<std::uint64_t> ids;
+  std::vector<cv::Point2d> first, second;
+};
+Correspondences matchById(const TrackFrame& first, const TrackFrame& second);
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,227 @@
+#include "plane_messages.h"
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <cmath>
+#include <sstream>
+#include <unordered_map>
+
+#include "mono_plane_detection/draw_planes.h"
+
+namespace mono_plane_detection {
+
+TrackFrame toTrackFrame(const Tracks& msg, std::string& error) {
+  TrackFrame frame;
+  const size_t n = msg.id.size();
+  if (msg.u.size() != n || msg.v.size() != n || msg.flags.size() != n ||
+      msg.prev_index.size() != n || msg.age.size() != n) {
+    std::ostringstream why;
+    why << "array lengths differ: id " << n << ", u " << msg.u.size() << ", v " << msg.v.size()
+        << ", flags " << msg.flags.size() << ", prev_index " << msg.prev_index.size() << ", age "
+        << msg.age.size();
+    error = why.str();
+    return frame;
+  }
+  frame.stamp = msg.header.stamp.toSec();
+  frame.size = cv::Size(static_cast<int>(msg.width), static_cast<int>(msg.height));
+  frame.ids.assign(msg.id.begin(), msg.id.end());
+  frame.pixels.reserve(n);
+  frame.target_corner.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    frame.pixels.emplace_back(msg.u[i], msg.v[i]);
+    frame.target_corner.push_back((msg.flags[i] & Tracks::FLAG_TARGET_CORNER) != 0);
+  }
+  error = validateTrackFrame(frame);
+  return frame;
+}
+
+std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D) {
+  for (int i = 0; i < 9; ++i) K.val[i] = info.K[i];
+  if (const std::string error = cameraIntrinsicsError(K, cv::Mat()); !error.empty())
+    return error + " (camera_info K)";
+  if (!info.D.empty() && info.distortion_model != "plumb_bob" &&
+      info.distortion_model != "rational_polynomial")
+    return "distortion model '" + info.distortion_model + "' is not supported";
+  D = cv::Mat(info.D, true).reshape(1, 1);
+  if (!D.empty() && !cv::checkRange(D)) return "a distortion coefficient is not finite";
+  return {};
+}
+
+namespace {
+
+void fill(PlaneEstimate& out, const MapPlane& plane) {
+  out.id = plane.id;
+  out.metric = true;
+  out.normal.x = plane.normal[0];
+  out.normal.y = plane.normal[1];
+  out.normal.z = plane.normal[2];
+  out.distance = plane.distance;
+  for (const auto& v : plane.polygon) {
+    geometry_msgs::Point p;
+    p.x = v[0];
+    p.y = v[1];
+    p.z = v[2];
+    out.polygon.push_back(p);
+  }
+  out.observations = static_cast<uint32_t>(plane.observations);
+  out.confidence = static_cast<float>(plane.confidence);
+  out.rms_m = static_cast<float>(plane.rms_m);
+}
+
+void fill(PlaneEstimate& out, const ImagePlane& plane) {
+  out.observed = true;
+  for (int i = 0; i < 9; ++i) out.homography[i] = plane.H.val[i];
+  out.inlier_ids.assign(plane.inlier_ids.begin(), plane.inlier_ids.end());
+  out.rms_error_px = static_cast<float>(plane.rms_error_px);
+}
+
+std_msgs::ColorRGBA colourOf(int id, double alpha) {
+  const cv::Scalar bgr = planeColour(id);
+  std_msgs::ColorRGBA c;
+  c.r = static_cast<float>(bgr[2] / 255.0);
+  c.g = static_cast<float>(bgr[1] / 255.0);
+  c.b = static_cast<float>(bgr[0] / 255.0);
+  c.a = static_cast<float>(alpha);
+  return c;
+}
+
+geometry_msgs::Point point(const cv::Vec3d& v) {
+  geometry_msgs::Point p;
+  p.x = v[0];
+  p.y = v[1];
+  p.z = v[2];
+  return p;
+}
+
+}  // namespace
+
+PlaneArrayPtr toPlaneArray(const std_msgs::Header& image_header, const std::string& map_frame,
+                           const PipelineResult& result, const PlaneMap& map) {
+  PlaneArrayPtr msg(new PlaneArray);
+  msg->header = image_header;
+  msg->status = result.status;
+  msg->metric = result.pose.has_value() && result.state == PipelineState::kTracking;
+  msg->reference_stamp = result.reference_stamp > 0 ? result.reference_stamp : 0.0;
+  if (msg->metric) {
+    msg->header.frame_id = map_frame;
+    std::unordered_map<int, const ImagePlane*> seen;
+    for (const ImagePlane& p : result.planes)
+      if (p.map_id >= 0) seen.emplace(p.map_id, &p);
+    for (int pass = 0; pass < 2; ++pass)  // observed planes first
+      for (const MapPlane& plane : map.planes()) {
+        const auto it = seen.find(plane.id);
+        if ((it != seen.end()) != (pass == 0)) continue;
+        PlaneEstimate out;
+        fill(out, plane);
+        if (it != seen.end()) fill(out, *it->second);
+        msg->planes.push_back(out);
+      }
+  } else {
+    for (const ImagePlane& p : result.planes) {
+      PlaneEstimate out;
+      out.id = p.id;
+      fill(out, p);
+      out.observations = 1;
+      msg->planes.push_back(out);
+    }
+  }
+  return msg;
+}
+
+visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
+                                             std::set<int>& shown) {
+  visualization_msgs::MarkerArrayPtr markers(new visualization_msgs::MarkerArray);
+  std::set<int> now;
+  for (const MapPlane& plane : map.planes()) {
+    if (plane.polygon.size() < 3) continue;
+    now.insert(plane.id);
+    const double alpha = 0.15 + 0.5 * plane.confidence;
+    visualization_msgs::Marker surface;
+    surface.header = header;
+    surface.ns = "planes";
+    surface.id = plane.id;
+    surface.type = visualization_msgs::Marker::TRIANGLE_LIST;
+    surface.action = visualization_msgs::Marker::ADD;
+    surface.pose.orientation.w = 1;
+    surface.scale.x = surface.scale.y = surface.scale.z = 1;
+    surface.color = colourOf(plane.id, alpha);
+    cv::Vec3d centre(0, 0, 0);
+    for (const auto& v : plane.polygon) centre += v;
+    centre /= static_cast<double>(plane.polygon.size());
+    for (size_t k = 0; k < plane.polygon.size(); ++k) {  // a fan from the centre
+      surface.points.push_back(point(centre));
+      surface.points.push_back(point(plane.polygon[k]));
+      surface.points.push_back(point(plane.polygon[(k + 1) % plane.polygon.size()]));
+    }
+    markers->markers.push_back(surface);
+
+    visualization_msgs::Marker arrow = surface;
+    arrow.ns = "normals";
+    arrow.type = visualization_msgs::Marker::ARROW;
+    arrow.points = {point(centre), point(centre + 0.3 * plane.normal)};
+    arrow.scale.x = 0.02;
+    arrow.scale.y = 0.04;
+    arrow.scale.z = 0.06;
+    arrow.color.a = 1;
+    markers->markers.push_back(arrow);
+
+    visualization_msgs::Marker label = surface;
+    label.ns = "labels";
+    label.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    label.points.clear();
+    label.pose.position = point(centre + 0.35 * plane.normal);
+    label.scale.z = 0.12;
+    label.color.r = label.color.g = label.color.b = label.color.a = 1;
+    std::ostringstream text;
+    text.precision(2);
+    text << std::fixed << "plane " << plane.id << " (" << plane.observations << ")";
+    label.text = text.str();
+    markers->markers.push_back(label);
+  }
+  for (int id : shown) {
+    if (now.count(id)) continue;
+    for (const char* ns : {"planes", "normals", "labels"}) {
+      visualization_msgs::Marker gone;
+      gone.header = header;
+      gone.ns = ns;
+      gone.id = id;
+      gone.action = visualization_msgs::Marker::DELETE;
+      markers->markers.push_back(gone);
+    }
+  }
+  shown = now;
+  return markers;
+}
+
+sensor_msgs::PointCloud2Ptr toCloud(const std_msgs::Header& header, const PoseEstimator& pose,
+                                    const PlaneMap& map) {
+  std::unordered_map<std::uint64_t, int> plane_of;
+  for (const MapPlane& plane : map.planes())
+    for (const auto& entry : plane.points) plane_of[entry.first] = plane.id;
+  size_t count = 0;
+  for (const auto& entry : pose.landmarks())
+    count += entry.second.triangulated || entry.second.fixed;
+
+  sensor_msgs::PointCloud2Ptr cloud(new sensor_msgs::PointCloud2);
+  cloud->header = header;
+  sensor_msgs::PointCloud2Modifier modifier(*cloud);
+  modifier.setPointCloud2FieldsByString(2, "xyz", "rgb");
+  modifier.resize(count);
+  sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
+  sensor_msgs::PointCloud2Iterator<uint8_t> r(*cloud, "r"), g(*cloud, "g"), b(*cloud, "b");
+  for (const auto& [id, l] : pose.landmarks()) {
+    if (!(l.triangulated || l.fixed)) continue;
+    *x = static_cast<float>(l.position[0]);
+    *y = static_cast<float>(l.position[1]);
+    *z = static_cast<float>(l.position[2]);
+    const auto it = plane_of.find(id);
+    const cv::Scalar bgr = it != plane_of.end() ? planeColour(it->second) : cv::Scalar(200, 200, 200);
+    *r = static_cast<uint8_t>(bgr[2]);
+    *g = static_cast<uint8_t>(bgr[1]);
+    *b = static_cast<uint8_t>(bgr[0]);
+    ++x, ++y, ++z, ++r, ++g, ++b;
+  }
+  return cloud;
+}
+
+}  // namespace mono_plane_detection

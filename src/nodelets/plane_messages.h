@@ -1,0 +1,38 @@
+// Conversions between the plane stage's ROS messages and the core's types: Tracks in,
+// PlaneArray, rviz markers and the map's point cloud out.
+#pragma once
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <set>
+#include <string>
+
+#include "mono_plane_detection/PlaneArray.h"
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/plane_pipeline.h"
+
+namespace mono_plane_detection {
+
+// The frame, or an error naming what is wrong (array lengths, values).
+TrackFrame toTrackFrame(const Tracks& msg, std::string& error);
+
+// K and distortion from a CameraInfo; an error when unusable (zero, NaN, no K).
+std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D);
+
+// Metric: every map plane (observed ones first, with homography and inliers); else this
+// image's planes in image space.
+PlaneArrayPtr toPlaneArray(const std_msgs::Header& image_header, const std::string& map_frame,
+                           const PipelineResult& result, const PlaneMap& map);
+
+// A translucent polygon, a normal arrow and a label per map plane; DELETE markers for
+// planes that were published before and are gone (`shown` is updated).
+visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
+                                             std::set<int>& shown);
+
+// Triangulated landmarks (x, y, z, rgb), coloured by the map plane they are on.
+sensor_msgs::PointCloud2Ptr toCloud(const std_msgs::Header& header, const PoseEstimator& pose,
+                                    const PlaneMap& map);
+
+}  // namespace mono_plane_detection

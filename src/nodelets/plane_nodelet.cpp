@@ -1,0 +1,296 @@
+// Thin ROS glue around PlanePipeline: tracks (+ camera_info, optional odometry tf) in;
+// planes, rviz markers, the map's points, map -> camera tf and a debug image out.
+#include <cv_bridge/cv_bridge.h>
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <opencv2/calib3d.hpp>
+#include <diagnostic_updater/update_functions.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <image_transport/image_transport.h>
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <pluginlib/class_list_macros.hpp>
+
+#include "mono_plane_detection/draw_planes.h"
+#include "plane_messages.h"
+#include "plane_params.h"
+
+namespace mono_plane_detection {
+namespace {
+
+geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child,
+                                            const std_msgs::Header& header,
+                                            const std::string& parent, const std::string& child) {
+  geometry_msgs::TransformStamped tf;
+  tf.header.stamp = header.stamp;
+  tf.header.frame_id = parent;
+  tf.child_frame_id = child;
+  tf.transform.translation.x = parent_from_child.t[0];
+  tf.transform.translation.y = parent_from_child.t[1];
+  tf.transform.translation.z = parent_from_child.t[2];
+  cv::Vec3d rvec;
+  cv::Rodrigues(parent_from_child.R, rvec);
+  const double angle = cv::norm(rvec);
+  const cv::Vec3d axis = angle > 1e-12 ? rvec / angle : cv::Vec3d(1, 0, 0);
+  tf.transform.rotation.w = std::cos(angle / 2);
+  tf.transform.rotation.x = axis[0] * std::sin(angle / 2);
+  tf.transform.rotation.y = axis[1] * std::sin(angle / 2);
+  tf.transform.rotation.z = axis[2] * std::sin(angle / 2);
+  return tf;
+}
+
+Pose fromTransform(const geometry_msgs::Transform& t) {
+  const double w = t.rotation.w, x = t.rotation.x, y = t.rotation.y, z = t.rotation.z;
+  Pose p;
+  p.R = cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                    2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                    2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
+  p.t = cv::Vec3d(t.translation.x, t.translation.y, t.translation.z);
+  return p;
+}
+
+}  // namespace
+
+class PlaneNodelet : public nodelet::Nodelet {
+ public:
+  ~PlaneNodelet() override {
+    if (updater_) updater_->broadcast(diagnostic_msgs::DiagnosticStatus::OK, "shutting down");
+  }
+
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& pnh = getPrivateNodeHandle();
+    params_ = readPipelineParams(pnh, getName());
+    pipeline_ = std::make_unique<PlanePipeline>(params_);
+    pnh.param<std::string>("map_frame", map_frame_, "map");
+    pnh.param<std::string>("odom_frame", odom_frame_, "");
+    pnh.param("publish_tf", publish_tf_, true);
+    pnh.param<std::string>("image_transport", transport_, "raw");
+
+    planes_pub_ = nh.advertise<PlaneArray>("planes", 5);
+    markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("plane_markers", 5);
+    cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("map_points", 2);
+    image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+    // The image is only needed to draw on: subscribe while someone watches the drawing.
+    debug_pub_ = image_transport_->advertise(
+        "debug_image", 1, [this](const image_transport::SingleSubscriberPublisher&) { connect(); },
+        [this](const image_transport::SingleSubscriberPublisher&) { connect(); });
+    if (publish_tf_) broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+    if (!odom_frame_.empty()) {
+      tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+      tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+    }
+
+    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
+    updater_->setHardwareID("camera");
+    rate_diagnostic_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
+        diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
+    pnh.param("expected_min_rate_hz", min_rate_, 5.0);
+    pnh.param("expected_max_rate_hz", max_rate_, 100.0);
+    updater_->add(*rate_diagnostic_);
+    updater_->add("planes", this, &PlaneNodelet::diagnose);
+    diagnostic_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
+      updater_->update();
+    });
+
+    // The map must follow every image, so tracks are always subscribed (the tracker
+    // itself runs lazily: only while this nodelet listens).
+    tracks_sub_ = nh.subscribe("tracks", 5, &PlaneNodelet::onTracks, this);
+    info_sub_ = nh.subscribe("camera_info", 2, &PlaneNodelet::onCameraInfo, this);
+    no_info_timer_ = nh.createTimer(
+        ros::Duration(5.0),
+        [this](const ros::TimerEvent&) {
+          std::lock_guard<std::mutex> lock(mutex_);
+          if (!pipeline_->hasCamera() && frames_ > 0)
+            NODELET_WARN("no usable camera_info after 5 s: image-space planes only");
+        },
+        true);
+  }
+
+  void connect() {
+    std::lock_guard<std::mutex> lock(connect_mutex_);
+    if (debug_pub_.getNumSubscribers() > 0 && !image_sub_) {
+      image_sub_ = image_transport_->subscribe("image", 2, &PlaneNodelet::onImage, this,
+                                               image_transport::TransportHints(transport_));
+    } else if (debug_pub_.getNumSubscribers() == 0 && image_sub_) {
+      image_sub_.shutdown();
+      std::lock_guard<std::mutex> state(mutex_);
+      images_.clear();
+    }
+  }
+
+  void onImage(const sensor_msgs::ImageConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    images_.push_back(msg);
+    while (images_.size() > 10) images_.pop_front();
+  }
+
+  void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
+    cv::Matx33d K;
+    cv::Mat D;
+    const std::string error = fromCameraInfo(*msg, K, D);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!error.empty()) {
+      ++dropped_info_;
+      NODELET_WARN_THROTTLE(10.0, "camera_info rejected: %s; image-space planes only",
+                            error.c_str());
+      return;
+    }
+    info_size_ = cv::Size(static_cast<int>(msg->width), static_cast<int>(msg->height));
+    pipeline_->setCamera(K, D);
+  }
+
+  std::optional<Pose> odometry(const std_msgs::Header& header) {
+    if (odom_frame_.empty()) return {};
+    try {
+      // Never wait in a callback: take what tf has for this stamp or go visual.
+      const auto tf = tf_buffer_->lookupTransform(odom_frame_, header.frame_id, header.stamp);
+      return fromTransform(tf.transform);
+    } catch (const tf2::TransformException& e) {
+      NODELET_WARN_THROTTLE(10.0, "no %s -> %s transform at %.3f (%s): visual pose only",
+                            odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
+                            e.what());
+      return {};
+    }
+  }
+
+  void onTracks(const TracksConstPtr& msg) {
+    std::string error;
+    const TrackFrame frame = toTrackFrame(*msg, error);
+    if (!error.empty()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++dropped_;
+      NODELET_ERROR_THROTTLE(5.0, "tracks dropped: %s", error.c_str());
+      return;
+    }
+    const std::optional<Pose> odom = odometry(msg->header);
+    PlaneArrayPtr planes;
+    visualization_msgs::MarkerArrayPtr markers;
+    sensor_msgs::PointCloud2Ptr cloud;
+    cv::Mat drawing;
+    std::optional<geometry_msgs::TransformStamped> tf;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!info_size_.empty() && info_size_ != frame.size)
+        NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",
+                              info_size_.width, info_size_.height, frame.size.width,
+                              frame.size.height);
+      const PipelineResult result = pipeline_->process(frame, odom);
+      if (result.was_reset) {
+        NODELET_WARN("tracks stamp %.3f is before the previous one: time went backwards (bag "
+                     "loop?), the map starts over",
+                     frame.stamp);
+        markers_shown_.clear();
+        reset_markers_ = true;
+      }
+      if (result.tracking_loss)
+        NODELET_WARN_THROTTLE(5.0, "%.1f s without tracks: tracking lost, waiting for the map "
+                                   "or the target to place the camera again",
+                              params_.max_gap_s);
+      if (result.state != last_state_) {
+        NODELET_INFO("%s", result.status.c_str());
+        last_state_ = result.state;
+      }
+      ++frames_;
+      status_ = result.status;
+      observed_ = result.planes.size();
+      planes = toPlaneArray(msg->header, map_frame_, result, pipeline_->map());
+      if (planes->metric) {
+        std_msgs::Header map_header = msg->header;
+        map_header.frame_id = map_frame_;
+        if (markers_pub_.getNumSubscribers() > 0 || reset_markers_) {
+          markers = toMarkers(map_header, pipeline_->map(), markers_shown_);
+          if (reset_markers_) {
+            visualization_msgs::Marker clear;
+            clear.action = visualization_msgs::Marker::DELETEALL;
+            markers->markers.insert(markers->markers.begin(), clear);
+            reset_markers_ = false;
+          }
+        }
+        if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
+          cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
+        if (publish_tf_) {
+          Pose parent_from_camera = result.pose->map_from_camera;
+          std::string parent = map_frame_;
+          if (odom) {  // map -> odom, so that the robot's own tf tree stays a tree
+            parent_from_camera = result.pose->map_from_camera * odom->inverse();
+            tf = toTransform(parent_from_camera, msg->header, map_frame_, odom_frame_);
+          } else {
+            tf = toTransform(parent_from_camera, msg->header, parent, msg->header.frame_id);
+          }
+        }
+      }
+      if (debug_pub_.getNumSubscribers() > 0) {
+        for (const auto& image : images_)
+          if (image->header.stamp == msg->header.stamp) {
+            try {
+              drawing = drawPlanes(cv_bridge::toCvShare(image, "mono8")->image, result);
+            } catch (const cv_bridge::Exception& e) {
+              NODELET_WARN_THROTTLE(10.0, "cannot draw on the image: %s", e.what());
+            }
+          }
+      }
+    }
+    rate_diagnostic_->tick();
+    planes_pub_.publish(planes);  // shared pointers: no copy inside one manager
+    if (markers) markers_pub_.publish(markers);
+    if (cloud) cloud_pub_.publish(cloud);
+    if (tf) broadcaster_->sendTransform(*tf);
+    if (!drawing.empty())
+      debug_pub_.publish(cv_bridge::CvImage(msg->header, "bgr8", drawing).toImageMsg());
+  }
+
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool dropped = dropped_ > 0 || dropped_info_ > 0;
+    status.summary(dropped ? diagnostic_msgs::DiagnosticStatus::WARN
+                           : diagnostic_msgs::DiagnosticStatus::OK,
+                   status_.empty() ? "no tracks yet" : status_);
+    status.add("images processed", frames_);
+    status.add("tracks messages dropped", dropped_);
+    status.add("camera_info messages rejected", dropped_info_);
+    status.add("planes in this image", observed_);
+    status.add("planes in the map", pipeline_->map().planes().size());
+    if (pipeline_->poseEstimator())
+      status.add("landmarks", pipeline_->poseEstimator()->landmarks().size());
+  }
+
+  PipelineParams params_;
+  std::unique_ptr<PlanePipeline> pipeline_;
+  std::string map_frame_, odom_frame_, transport_;
+  bool publish_tf_ = true;
+
+  ros::Publisher planes_pub_, markers_pub_, cloud_pub_;
+  ros::Subscriber tracks_sub_, info_sub_;
+  std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  image_transport::Publisher debug_pub_;
+  image_transport::Subscriber image_sub_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
+  std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  ros::Timer diagnostic_timer_, no_info_timer_;
+  std::unique_ptr<diagnostic_updater::Updater> updater_;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_diagnostic_;
+  double min_rate_ = 5.0, max_rate_ = 100.0;
+
+  std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
+  std::deque<sensor_msgs::ImageConstPtr> images_;
+  cv::Size info_size_;
+  std::set<int> markers_shown_;
+  bool reset_markers_ = false;
+  PipelineState last_state_ = PipelineState::kNoCamera;
+  std::string status_;
+  long frames_ = 0, dropped_ = 0, dropped_info_ = 0;
+  size_t observed_ = 0;
+};
+
+}  // namespace mono_plane_detection
+
+PLUGINLIB_EXPORT_CLASS(mono_plane_detection::PlaneNodelet, nodelet::Nodelet)

@@ -1,0 +1,215 @@
+// Runs the whole method in one process, without ROS, on a rendered room: tracker with
+// target start-up, plane pipeline, metric map; prints the map against the ground truth.
+// For tuning, the soak run (issue: long runs) and a quick look without a ROS master.
+//   rosrun mono_plane_detection run_pipeline --trajectory humanoid --frames 300
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "cli_args.h"
+#include "mono_plane_detection/camera_trajectory.h"
+#include "mono_plane_detection/map_evaluation.h"
+#include "mono_plane_detection/plane_pipeline.h"
+#include "mono_plane_detection/scene_renderer.h"
+#include "mono_plane_detection/target_startup.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+const char* kUsage =
+    "usage: run_pipeline [options]\n"
+    "  Renders a room seen from a moving camera and runs tracker + planes + map on it,\n"
+    "  then prints each mapped plane against the ground truth and the camera path error.\n"
+    "  --trajectory wheeled|humanoid|rotation [wheeled]   --frames N [300]   --fps F [30]\n"
+    "  --noise SIGMA [2] (grey levels)   --seed S [1]   --frame-gap N [5]\n"
+    "  --width W [640] --height H [480]   --features N [50] (tracker's max_features)\n"
+    "  --report-every N [0: only the end]\n"
+    "  --loop N [1]: run the sequence N times (soak: the map is reset at each loop, as a\n"
+    "      bag loop does; prints resident memory and time per frame per loop)\n";
+
+double residentMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // peak; flat peak = no growth
+}
+
+double currentRssMb() {
+  FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return residentMb();
+  long pages = 0, resident = 0;
+  const int n = std::fscanf(f, "%ld %ld", &pages, &resident);
+  std::fclose(f);
+  return n == 2 ? resident * 4096.0 / (1024 * 1024) : residentMb();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  TrajectoryParams trajectory;
+  CameraModel camera;
+  RenderOptions render;
+  render.noise_sigma = 2;
+  int frames = 300, report_every = 0, loops = 1, frame_gap = 5, features = 50;
+  double fps = 30;
+  unsigned seed = 1;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    if (i + 1 >= argc) return usageError(argv[0], arg + " needs a value", kUsage);
+    const std::string value = argv[++i];
+    double x = 0;
+    if (arg == "--trajectory") {
+      trajectory.name = value;
+      if (value != "wheeled" && value != "humanoid" && value != "rotation")
+        return usageError(argv[0], "unknown trajectory " + value, kUsage);
+      continue;
+    }
+    if (!parseNumber(value.c_str(), x) || x < 0)
+      return usageError(argv[0], arg + " needs a non-negative number", kUsage);
+    if (arg == "--frames")
+      frames = static_cast<int>(x);
+    else if (arg == "--fps" && x > 0)
+      fps = x;
+    else if (arg == "--noise")
+      render.noise_sigma = x;
+    else if (arg == "--seed")
+      seed = static_cast<unsigned>(x);
+    else if (arg == "--frame-gap" && x >= 1)
+      frame_gap = static_cast<int>(x);
+    else if (arg == "--width" && x >= 64)
+      camera.size.width = static_cast<int>(x);
+    else if (arg == "--height" && x >= 48)
+      camera.size.height = static_cast<int>(x);
+    else if (arg == "--report-every")
+      report_every = static_cast<int>(x);
+    else if (arg == "--features" && x >= 5)
+      features = static_cast<int>(x);
+    else if (arg == "--loop" && x >= 1)
+      loops = static_cast<int>(x);
+    else
+      return usageError(argv[0], "bad option " + arg + " " + value, kUsage);
+  }
+  // Keep the focal length's field of view when the size changes.
+  camera.fx = camera.fy = 525.0 * camera.size.width / 640.0;
+  camera.cx = (camera.size.width - 1) / 2.0;
+  camera.cy = (camera.size.height - 1) / 2.0;
+  trajectory.seed = seed;
+
+  RoomParams room;
+  room.seed = seed;
+  const IndoorScene scene = makeRoom(room);
+  const SceneRenderer renderer(scene, camera, render);
+  std::vector<TruthPlane> truth = truthPlanes(scene);
+  const Pose map_from_world = scene.target.world_from_map.inverse();
+
+  TrackerParams tracker_params;
+  tracker_params.max_features = features;
+  if (trajectory.name == "humanoid") {  // config/tracker_humanoid.yaml
+    tracker_params.pyramid_levels = 6;
+    tracker_params.window_size_px = 15;
+  }
+  PipelineParams params;
+  params.frame_gap = frame_gap;
+
+  using Clock = std::chrono::steady_clock;
+  std::printf("run_pipeline: %s, %d frames x %d loop(s), %dx%d, noise %.1f\n",
+              trajectory.name.c_str(), frames, loops, camera.size.width, camera.size.height,
+              render.noise_sigma);
+  FeatureTracker tracker(tracker_params);
+  TargetStartup startup;
+  PlanePipeline pipeline(params);
+  pipeline.setCamera(camera.K(), camera.distortion());
+  const double start_rss = currentRssMb();
+  int exit_code = 0;
+  for (int loop = 0; loop < loops; ++loop) {
+    tracker.reset();
+    startup.reset();
+    double track_ms = 0, plane_ms = 0, travelled = 0, pos_err_sum = 0, pos_err_max = 0;
+    int posed = 0, tracking = 0;
+    cv::Vec3d last_position;
+    for (int k = 0; k < frames; ++k) {
+      const double t = k / fps;
+      const Pose world_from_camera = trajectoryPose(trajectory, t);
+      if (loop == 0) {
+        const std::vector<double> shares = imageShares(scene, camera, world_from_camera, 16);
+        for (size_t p = 0; p < truth.size(); ++p)
+          truth[p].max_image_share = std::max(truth[p].max_image_share, shares[p]);
+      }
+      const cv::Mat image = renderer.render(world_from_camera, seed * 100000u + k);
+      const auto t0 = Clock::now();
+      const auto& points = tracker.process(image);
+      startup.process(image, tracker);
+      const auto t1 = Clock::now();
+      TrackFrame frame;
+      frame.stamp = 1000.0 + loop * 0.0 + t;  // every loop starts over in time: a bag loop
+      frame.size = image.size();
+      for (const TrackedPoint& p : tracker.current()) {
+        frame.ids.push_back(p.id);
+        frame.pixels.emplace_back(p.uv.x, p.uv.y);
+        frame.target_corner.push_back(p.is_target_corner);
+      }
+      (void)points;
+      const PipelineResult result = pipeline.process(frame);
+      const auto t2 = Clock::now();
+      track_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
+      plane_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
+      const Pose truth_pose = map_from_world * world_from_camera;
+      if (k > 0) travelled += cv::norm(truth_pose.t - last_position);
+      last_position = truth_pose.t;
+      double frame_err = -1;
+      if (result.pose) {
+        const double err = cv::norm(result.pose->map_from_camera.t - truth_pose.t);
+        pos_err_sum += err;
+        pos_err_max = std::max(pos_err_max, err);
+        frame_err = err;
+        ++posed;
+      }
+      tracking += result.state == PipelineState::kTracking;
+      if (report_every > 0 && (k + 1) % report_every == 0)
+        std::printf("  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
+                    "position error %.3f m\n",
+                    k + 1, result.status.c_str(), result.planes.size(),
+                    pipeline.map().planes().size(), frame.ids.size(), frame_err);
+    }
+    const double rss = currentRssMb();
+    std::printf("loop %d: tracker %.2f ms/frame, planes+map %.2f ms/frame, RSS %.1f MB "
+                "(start %.1f), landmarks %zu, map planes %zu\n",
+                loop + 1, track_ms / frames, plane_ms / frames, rss, start_rss,
+                pipeline.poseEstimator()->landmarks().size(), pipeline.map().planes().size());
+    if (loop + 1 < loops) continue;
+    std::printf("camera: placed in %d/%d frames, position error mean %.3f m, max %.3f m, "
+                "travelled %.2f m (max error %.1f %% of it)\n",
+                posed, frames, posed ? pos_err_sum / posed : 0.0, pos_err_max, travelled,
+                travelled > 0 ? 100 * pos_err_max / travelled : 0.0);
+    std::vector<MapPlane> confirmed;
+    for (const MapPlane& p : pipeline.map().planes())
+      if (p.confirmed(pipeline.map().params())) confirmed.push_back(p);
+    const MapEvaluation eval = evaluateMap(confirmed, truth);
+    std::printf("planes (confirmed %zu of %zu):\n", confirmed.size(),
+                pipeline.map().planes().size());
+    for (size_t i = 0; i < confirmed.size(); ++i) {
+      const MapPlane& p = confirmed[i];
+      const PlaneMatch& m = eval.matches[i];
+      std::printf("  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
+                  "(normal %.2f deg, distance %.3f m)\n",
+                  p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(),
+                  p.observations, m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH",
+                  m.normal_error_deg, m.distance_error_m);
+    }
+    for (const TruthPlane& t : truth)
+      std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
+                  t.normal[0], t.normal[1], t.normal[2], t.distance, 100 * t.max_image_share);
+    for (int id : eval.missed) std::printf("  missed: true plane %d\n", id);
+    std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
+                eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
+                eval.worst_distance_error_m);
+    exit_code = eval.missed.empty() && eval.split.empty() ? 0 : 1;
+  }
+  return exit_code;
+}
