@@ -1,4 +1,6 @@
 # One entry point for people and CI. Every target installs what it needs first.
+#   make demo    install deps, build, make a humanoid sample sequence (or BAG=file.bag),
+#                run the whole pipeline on it headless, print and write the results
 #   make test    install deps, build, run every gtest and rostest, print a summary
 #   make build   install deps and build the catkin workspace under build/ws
 #   make bench   run the benchmark programs (figures, never pass/fail)
@@ -17,7 +19,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build test bench eval sanitize clean
+.PHONY: deps link build demo test bench eval sanitize clean
 
 deps:
 	@scripts/install_deps.sh
@@ -33,7 +35,19 @@ link:
 	@for f in $(REPO)/* $(REPO)/.ci; do [ "$$(basename $$f)" = build ] || ln -sfn $$f $(PKG)/; done
 
 build: deps link
-	@$(CATKIN)
+	@echo "build: catkin_make in $(WS) (log: $(WS)/build.log)"
+	@$(CATKIN) > $(WS)/build.log 2>&1 || { tail -40 $(WS)/build.log; exit 1; }
+
+# The main job. BAG=your.bag [TRUTH=its.yaml] replays your own bag; RVIZ=1 shows rviz
+# (installs it) instead of running headless; PROFILE=wheeled|humanoid; RESULTS=folder.
+RESULTS ?= $(REPO)/results
+PROFILE ?= humanoid
+FRAMES ?= 300
+RVIZ ?= 0
+demo: build
+	@[ "$(RVIZ)" != 1 ] || scripts/install_deps.sh rviz
+	@source $(DEVEL) && scripts/demo.sh $(RESULTS) $(PROFILE) $(FRAMES) \
+	  $(if $(filter 1,$(RVIZ)),true,false) $(if $(BAG),$(abspath $(BAG))) $(if $(TRUTH),$(abspath $(TRUTH)))
 
 test: build
 	@rm -rf $(WS)/build/test_results

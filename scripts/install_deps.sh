@@ -19,6 +19,7 @@ PACKAGES=(
   libyaml-cpp-dev libopencv-dev libeigen3-dev
 )
 
+PACKAGES+=("$@")  # extra packages a target needs (make demo RVIZ=1: rviz)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

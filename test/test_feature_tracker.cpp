@@ -261,7 +261,8 @@ TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
   tracker.process(warpView(texture(), hs[0], kView));
   // Four texture corners stand in for the target's.
   std::vector<cv::Point2f> corners;
-  for (int i = 0; i < 4; ++i) corners.push_back(tracker.current()[i * 5].uv + cv::Point2f(0.f, 0.f));
+  for (int i = 0; i < 4; ++i)
+    corners.push_back(tracker.current()[i * 5].uv + cv::Point2f(0.f, 0.f));
   const auto ids = tracker.addPoints(corners, true);
   ASSERT_EQ(ids.size(), 4u);
   for (auto id : ids) EXPECT_GT(id, tracker.current().front().id);

@@ -54,12 +54,12 @@ struct TrackedPoint {
   cv::Point3f position{std::numeric_limits<float>::quiet_NaN(),
                        std::numeric_limits<float>::quiet_NaN(),
                        std::numeric_limits<float>::quiet_NaN()};
-  bool is_new = false;           // found by the search on this image
-  bool is_tracked = false;       // followed by Lucas-Kanade from the previous image
-  bool is_reidentified = false;  // new corner that got back the id of a lost point
-  bool is_target_corner = false; // a corner of the start-up target (paper II-A)
-  int prev_index = -1;           // index in the previous state, -1 if new
-  int age = 0;                   // images since the point was first seen (0 when new)
+  bool is_new = false;            // found by the search on this image
+  bool is_tracked = false;        // followed by Lucas-Kanade from the previous image
+  bool is_reidentified = false;   // new corner that got back the id of a lost point
+  bool is_target_corner = false;  // a corner of the start-up target (paper II-A)
+  int prev_index = -1;            // index in the previous state, -1 if new
+  int age = 0;                    // images since the point was first seen (0 when new)
 };
 
 // What happened on the last processed image.

@@ -58,12 +58,12 @@ struct Plane {
 };
 
 struct PlaneSegmentation {
-  std::vector<Plane> planes;  // by support, largest first
-  std::vector<int> labels;    // per point: 0 = no plane, k >= 1 = planes[k-1]
-  int groups_built = 0;       // five-point groups tried (built and tested)
-  int groups_coplanar = 0;    // of those, accepted by the invariant test
+  std::vector<Plane> planes;                // by support, largest first
+  std::vector<int> labels;                  // per point: 0 = no plane, k >= 1 = planes[k-1]
+  int groups_built = 0;                     // five-point groups tried (built and tested)
+  int groups_coplanar = 0;                  // of those, accepted by the invariant test
   std::vector<PointGroup> accepted_groups;  // those groups (drawn in debug images)
-  std::string error;          // why nothing could be done (sizes differ, ...)
+  std::string error;                        // why nothing could be done (sizes differ, ...)
 };
 
 // Every dominant plane between two views of the same points (view1[i] <-> view2[i]).

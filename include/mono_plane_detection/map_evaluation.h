@@ -16,8 +16,8 @@ namespace mono_plane_detection {
 struct TruthPlane {
   int id = 0;
   std::string name;
-  cv::Vec3d normal;        // unit, map frame, into the room
-  double distance = 0;     // m: {x : normal . x = distance}
+  cv::Vec3d normal;            // unit, map frame, into the room
+  double distance = 0;         // m: {x : normal . x = distance}
   double max_image_share = 0;  // largest share of an image it covered (0..1)
 };
 
@@ -31,7 +31,7 @@ std::vector<double> imageShares(const IndoorScene& scene, const CameraModel& cam
 
 struct PlaneMatch {
   int map_id = 0;
-  int truth_id = -1;            // -1: matches no true plane (a false plane)
+  int truth_id = -1;  // -1: matches no true plane (a false plane)
   std::string truth_name;
   double normal_error_deg = 0;
   double distance_error_m = 0;  // |distance - true distance|
@@ -46,8 +46,8 @@ struct MapEvaluation {
 
 // Matches each mapped plane to the true plane with the closest normal among those within
 // the gates. Required: true planes with max_image_share >= min_share.
-MapEvaluation evaluateMap(const std::vector<MapPlane>& planes,
-                          const std::vector<TruthPlane>& truth, double min_share = 0.10,
-                          double max_angle_deg = 20.0, double max_offset_m = 0.3);
+MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector<TruthPlane>& truth,
+                          double min_share = 0.10, double max_angle_deg = 20.0,
+                          double max_offset_m = 0.3);
 
 }  // namespace mono_plane_detection

@@ -18,8 +18,8 @@ struct PlaneFit {
 
 // Fails (ok = false) with fewer than min_points inliers or when they lie close to a
 // line (second spread below min_spread_m). Deterministic for given points.
-PlaneFit fitPlane(const std::vector<cv::Vec3d>& points, double max_residual_m,
-                  int min_points = 4, double min_spread_m = 0.05);
+PlaneFit fitPlane(const std::vector<cv::Vec3d>& points, double max_residual_m, int min_points = 4,
+                  double min_spread_m = 0.05);
 
 // Flips the plane so that its normal points towards `viewpoint` (the side it was seen from).
 void orientTowards(PlaneFit& plane, const cv::Vec3d& viewpoint);

@@ -32,14 +32,14 @@ std::string cameraIntrinsicsError(const cv::Matx33d& K, const cv::Mat& distortio
 
 // A plane found in this image (image space).
 struct ImagePlane {
-  int id = 0;                    // stable while the plane keeps most of its tracks
-  cv::Matx33d H;                 // reference image pixel -> this image pixel
+  int id = 0;     // stable while the plane keeps most of its tracks
+  cv::Matx33d H;  // reference image pixel -> this image pixel
   std::vector<std::uint64_t> inlier_ids;
   double rms_error_px = 0;
-  int map_id = -1;               // the map plane it was fused into, -1 when none
+  int map_id = -1;  // the map plane it was fused into, -1 when none
 };
 
-enum class PipelineState { kNoCamera, kWaitingForTarget, kLost, kTracking };
+enum class PipelineState { kNoCamera, kWaitingForTarget, kInitialising, kLost, kTracking };
 
 struct PipelineResult {
   PipelineState state = PipelineState::kNoCamera;
@@ -63,8 +63,7 @@ class PlanePipeline {
   bool hasCamera() const { return pose_.has_value(); }
 
   // Frames must be valid (validateTrackFrame). odom_from_camera: robot odometry, if any.
-  PipelineResult process(const TrackFrame& frame,
-                         const std::optional<Pose>& odom_from_camera = {});
+  PipelineResult process(const TrackFrame& frame, const std::optional<Pose>& odom_from_camera = {});
 
   const PlaneMap& map() const { return map_; }
   const PoseEstimator* poseEstimator() const { return pose_ ? &*pose_ : nullptr; }

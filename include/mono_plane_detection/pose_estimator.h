@@ -21,7 +21,7 @@
 namespace mono_plane_detection {
 
 struct PoseParams {
-  double min_parallax_deg = 2.0;      // triangulate a track once its two rays differ this much
+  double min_parallax_deg = 3.0;      // triangulate a track once its two rays differ this much
   double retriangulate_factor = 1.5;  // and again each time its parallax grows by this factor
   double max_reprojection_px = 2.0;   // PnP inliers and triangulation check
   int min_pnp_points = 8;             // landmarks needed to place the camera without the target
@@ -36,12 +36,12 @@ struct PoseParams {
 // camera pose (the anchor) is known.
 struct Landmark {
   bool triangulated = false;
-  bool fixed = false;         // a target corner: position known exactly
-  cv::Vec3d position;         // map frame, m (when triangulated or fixed)
-  Pose anchor_pose;           // map_from_camera at the anchor observation
+  bool fixed = false;             // a target corner: position known exactly
+  cv::Vec3d position;             // map frame, m (when triangulated or fixed)
+  Pose anchor_pose;               // map_from_camera at the anchor observation
   cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
-  double parallax_deg = 0;    // between the two rays of the triangulation
-  double last_seen = 0;       // stamp, s
+  double parallax_deg = 0;        // between the two rays of the triangulation
+  double last_seen = 0;           // stamp, s
 };
 
 enum class PoseSource { kTarget, kLandmarks, kOdometry };
@@ -50,8 +50,8 @@ const char* toString(PoseSource source);
 struct PoseEstimate {
   Pose map_from_camera;
   PoseSource source = PoseSource::kTarget;
-  int points = 0;        // correspondences behind it (PnP inliers, target corners)
-  double rms_px = 0;     // their reprojection error
+  int points = 0;     // correspondences behind it (PnP inliers, target corners)
+  double rms_px = 0;  // their reprojection error
 };
 
 class PoseEstimator {
@@ -61,7 +61,8 @@ class PoseEstimator {
                 const TargetParams& target = TargetParams());
 
   // The camera's pose for this frame, nothing while it cannot be known (target not seen
-  // yet, too few landmarks). Triangulates new landmarks when the pose is known.
+  // yet, start not done: not enough motion yet, too few landmarks). Triangulates new
+  // landmarks when the pose is known.
   // odom_from_camera: the robot's odometry for this frame, when it has one.
   std::optional<PoseEstimate> update(const TrackFrame& frame,
                                      const std::optional<Pose>& odom_from_camera = {});
@@ -91,7 +92,12 @@ class PoseEstimator {
   struct FirstView {  // the image the two-view start measures motion from
     std::vector<std::uint64_t> ids;
     std::vector<cv::Point2d> normalized;
+    // Its target corners, averaged over the later images carried back by the wall's
+    // homography (two_view_init.h explains why).
+    std::array<cv::Point2d, 4> corner_sum{};
+    int corner_count = 0;
   };
+  FirstView firstView(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const;
 
   cv::Matx33d K_;
   cv::Mat distortion_;

@@ -47,13 +47,14 @@ cv::Mat drawPlanes(const cv::Mat& image, const PipelineResult& result, int max_g
     if (label == 1) cv::circle(out, current[i], 6, colour, 1, cv::LINE_AA);  // dominant's voters
   }
   std::string text = result.status + ", " + std::to_string(result.planes.size()) + " plane(s)";
-  cv::putText(out, text, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+  cv::putText(out, text, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3,
+              cv::LINE_AA);
   cv::putText(out, text, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1,
               cv::LINE_AA);
   for (size_t k = 0; k < result.planes.size(); ++k) {
     const ImagePlane& p = result.planes[k];
-    const std::string label = "plane " + std::to_string(shownId(p)) + ": " +
-                              std::to_string(p.inlier_ids.size()) + " pts";
+    const std::string label =
+        "plane " + std::to_string(shownId(p)) + ": " + std::to_string(p.inlier_ids.size()) + " pts";
     cv::putText(out, label, {8, 40 + 18 * static_cast<int>(k)}, cv::FONT_HERSHEY_SIMPLEX, 0.5,
                 planeColour(shownId(p)), 1, cv::LINE_AA);
   }

@@ -38,9 +38,8 @@ std::vector<double> imageShares(const IndoorScene& scene, const CameraModel& cam
   return hits;
 }
 
-MapEvaluation evaluateMap(const std::vector<MapPlane>& planes,
-                          const std::vector<TruthPlane>& truth, double min_share,
-                          double max_angle_deg, double max_offset_m) {
+MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector<TruthPlane>& truth,
+                          double min_share, double max_angle_deg, double max_offset_m) {
   MapEvaluation eval;
   std::map<int, int> matched;  // truth id -> mapped planes matched to it
   for (const MapPlane& plane : planes) {

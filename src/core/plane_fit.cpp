@@ -110,7 +110,8 @@ std::vector<cv::Vec3d> planePolygon(const cv::Vec3d& normal, double distance,
   std::vector<cv::Point2f> hull;
   cv::convexHull(flat, hull, false);  // counter-clockwise in (u, v)
   std::vector<cv::Vec3d> polygon;
-  for (const auto& h : hull) polygon.push_back(distance * normal + double(h.x) * u + double(h.y) * v);
+  for (const auto& h : hull)
+    polygon.push_back(distance * normal + double(h.x) * u + double(h.y) * v);
   return polygon;
 }
 

@@ -29,55 +29,74 @@ void PlaneMap::reset() {
   next_id_ = 1;
 }
 
-std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observations,
-                                  double stamp) {
+std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observations, double stamp) {
   std::vector<int> ids(observations.size(), -1);
   cv::Vec3d viewpoint(0, 0, 0);
   for (size_t k = 0; k < observations.size(); ++k) {
     const PlaneObservation& obs = observations[k];
     viewpoint = obs.viewpoint;
-    if (static_cast<int>(obs.points.size()) < params_.min_points) continue;
-    PlaneFit fit = fitPlane(obs.points, params_.max_residual_m, params_.min_points);
-    if (!fit.ok) continue;
-    orientTowards(fit, obs.viewpoint);
-    PlaneObservation kept;
-    kept.viewpoint = obs.viewpoint;
-    for (int i : fit.inliers) {
-      kept.ids.push_back(obs.ids[i]);
-      kept.points.push_back(obs.points[i]);
+    const int needed = std::max(params_.min_points,
+                                static_cast<int>(std::ceil(params_.min_share * obs.points.size())));
+    PlaneObservation rest = obs;
+    size_t largest = 0;
+    while (static_cast<int>(rest.points.size()) >= needed) {
+      PlaneFit fit = fitPlane(rest.points, params_.max_residual_m, needed);
+      if (!fit.ok) break;
+      orientTowards(fit, obs.viewpoint);
+      PlaneObservation kept, others;
+      kept.viewpoint = others.viewpoint = obs.viewpoint;
+      std::vector<bool> in(rest.points.size(), false);
+      for (int i : fit.inliers) in[i] = true;
+      for (size_t i = 0; i < rest.points.size(); ++i) {
+        PlaneObservation& to = in[i] ? kept : others;
+        to.ids.push_back(rest.ids[i]);
+        to.points.push_back(rest.points[i]);
+      }
+      const int id = fuse(kept, fit.normal, fit.distance, stamp);
+      if (id >= 0 && kept.points.size() > largest) {
+        largest = kept.points.size();
+        ids[k] = id;
+      }
+      rest = std::move(others);
     }
-    const int match = associate(fit.normal, fit.distance, kept);
-    MapPlane* plane;
-    if (match < 0) {
-      planes_.emplace_back();
-      plane = &planes_.back();
-      plane->id = next_id_++;
-      plane->first_seen = stamp;
-      plane->normal = fit.normal;
-      plane->distance = fit.distance;
-    } else {
-      plane = &planes_[match];
-    }
-    for (size_t i = 0; i < kept.ids.size(); ++i) plane->points[kept.ids[i]] = {kept.points[i], stamp};
-    if (!refit(*plane, obs.viewpoint) && match < 0) {
-      planes_.pop_back();
-      --next_id_;
-      continue;
-    }
-    plane->observations += 1;
-    plane->last_seen = stamp;
-    ids[k] = plane->id;
   }
   mergeDuplicates(viewpoint);
   fadeAndBound(stamp);
   // A merge may have renamed a plane an observation went to.
   for (int& id : ids) {
     if (id < 0) continue;
-    const bool alive = std::any_of(planes_.begin(), planes_.end(),
-                                   [&](const MapPlane& p) { return p.id == id; });
+    const bool alive =
+        std::any_of(planes_.begin(), planes_.end(), [&](const MapPlane& p) { return p.id == id; });
     if (!alive) id = -1;
   }
   return ids;
+}
+
+int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance,
+                   double stamp) {
+  const int match = associate(normal, distance, kept);
+  MapPlane* plane;
+  if (match < 0) {
+    planes_.emplace_back();
+    plane = &planes_.back();
+    plane->id = next_id_++;
+    plane->first_seen = stamp;
+    plane->normal = normal;
+    plane->distance = distance;
+  } else {
+    plane = &planes_[match];
+  }
+  for (size_t i = 0; i < kept.ids.size(); ++i) plane->points[kept.ids[i]] = {kept.points[i], stamp};
+  if (!refit(*plane, kept.viewpoint)) {
+    if (match < 0) {
+      planes_.pop_back();
+      --next_id_;
+    }
+    return -1;
+  }
+  plane->observations += 1;
+  plane->last_seen = stamp;
+  return plane->id;
 }
 
 int PlaneMap::associate(const cv::Vec3d& normal, double distance,
@@ -148,9 +167,10 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
     for (size_t j = i + 1; j < planes_.size();) {
       MapPlane& a = planes_[i];
       const MapPlane& b = planes_[j];
-      const bool same = normalAngleDeg(a.normal, b.normal) <= params_.max_angle_deg &&
-                        meanAbsResidual(a.normal, a.distance, positions(b)) <= params_.max_offset_m &&
-                        meanAbsResidual(b.normal, b.distance, positions(a)) <= params_.max_offset_m;
+      const bool same =
+          normalAngleDeg(a.normal, b.normal) <= params_.max_angle_deg &&
+          meanAbsResidual(a.normal, a.distance, positions(b)) <= params_.max_offset_m &&
+          meanAbsResidual(b.normal, b.distance, positions(a)) <= params_.max_offset_m;
       if (!same) {
         ++j;
         continue;

@@ -37,8 +37,7 @@ std::string cameraIntrinsicsError(const cv::Matx33d& K, const cv::Mat& distortio
   return {};
 }
 
-PlanePipeline::PlanePipeline(const PipelineParams& params)
-    : params_(params), map_(params.map) {}
+PlanePipeline::PlanePipeline(const PipelineParams& params) : params_(params), map_(params.map) {}
 
 void PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distortion) {
   if (pose_ && K == K_ && cv::norm(distortion, distortion_, cv::NORM_INF) == 0) return;
@@ -121,6 +120,9 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   } else if (!pose_->scaleKnown()) {
     result.state = PipelineState::kWaitingForTarget;
     result.status = "waiting for target";
+  } else if (!pose_->initialised() && !result.pose) {
+    result.state = PipelineState::kInitialising;
+    result.status = "target seen, initialising: waiting for camera motion (parallax)";
   } else if (!result.pose) {
     result.state = PipelineState::kLost;
     result.status = "lost: too few mapped points in view";

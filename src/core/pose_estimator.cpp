@@ -18,7 +18,7 @@ double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
 
 cv::Matx34d cameraFromMap(const Pose& map_from_camera) {
   const Pose c = map_from_camera.inverse();
-  return {c.R(0, 0), c.R(0, 1), c.R(0, 2), c.t[0], c.R(1, 0), c.R(1, 1),
+  return {c.R(0, 0), c.R(0, 1), c.R(0, 2), c.t[0],    c.R(1, 0), c.R(1, 1),
           c.R(1, 2), c.t[1],    c.R(2, 0), c.R(2, 1), c.R(2, 2), c.t[2]};
 }
 
@@ -88,17 +88,18 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   std::vector<cv::Point2d> normalized;
   cv::undistortPoints(frame.pixels, normalized, K_, distortion_);
 
-  std::optional<PoseEstimate> estimate;
-  if (odom_from_camera && map_from_odom_) {
-    estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
-  } else if (!initialised_ && !odom_from_camera) {
-    return initialise(frame, normalized);  // nothing is triangulated before the start
-  } else {
-    estimate = visualPose(frame, normalized);
-    // With odometry, the target fixes where the odometry's origin sits in the map.
-    if (estimate && odom_from_camera && estimate->source == PoseSource::kTarget)
-      map_from_odom_ = estimate->map_from_camera * odom_from_camera->inverse();
+  if (!initialised_) {  // nothing is triangulated before the start
+    const std::optional<PoseEstimate> start = initialise(frame, normalized);
+    // With odometry, the start fixes where the odometry's origin sits in the map.
+    if (start && odom_from_camera)
+      map_from_odom_ = start->map_from_camera * odom_from_camera->inverse();
+    return start;
   }
+  std::optional<PoseEstimate> estimate;
+  if (odom_from_camera && map_from_odom_)
+    estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
+  else
+    estimate = visualPose(frame, normalized);
   if (!estimate) return {};
   last_pose_ = estimate->map_from_camera;
   for (size_t i = 0; i < frame.ids.size(); ++i) {
@@ -151,7 +152,8 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
       cv::Rodrigues(rvec, R);
       const Pose map_from_camera =
           Pose{R, cv::Vec3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2))}.inverse();
-      const bool jumped = last_pose_ && cv::norm(map_from_camera.t - last_pose_->t) > params_.max_jump_m;
+      const bool jumped =
+          last_pose_ && cv::norm(map_from_camera.t - last_pose_->t) > params_.max_jump_m;
       if (!jumped) {
         std::vector<cv::Point2d> projected;
         cv::projectPoints(obj_in, rvec, tvec, K_, distortion_, projected);
@@ -200,16 +202,15 @@ std::optional<PoseEstimate> PoseEstimator::targetPose(const TrackFrame& frame) c
 
 std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
                                                       const std::vector<cv::Point2d>& normalized) {
-  // Until the start succeeds the target alone places the camera (provisional).
-  const std::optional<PoseEstimate> provisional = targetPose(frame);
-  if (!provisional) {
-    first_view_.reset();  // the start needs the target in both views
+  // No pose is given out before the start succeeds: from one image the small target
+  // places the camera only to 0.1-0.3 m (its tilt is poorly defined, two_view_init.h).
+  if (!targetPose(frame)) {
+    first_view_.reset();  // the start needs the whole target in both views
     return {};
   }
-  last_pose_ = provisional->map_from_camera;
   if (!first_view_) {
-    first_view_ = FirstView{frame.ids, normalized};
-    return provisional;
+    first_view_ = firstView(frame, normalized);
+    return {};
   }
   std::unordered_map<std::uint64_t, size_t> in_first;
   for (size_t i = 0; i < first_view_->ids.size(); ++i) in_first.emplace(first_view_->ids[i], i);
@@ -229,12 +230,24 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
       std::all_of(target.begin(), target.end(), [](int i) { return i >= 0; });
   // Start again from this image when too few of the first view's tracks survive.
   if (!target_in_both || ids.size() * 2 < first_view_->ids.size()) {
-    first_view_ = FirstView{frame.ids, normalized};
-    return provisional;
+    first_view_ = firstView(frame, normalized);
+    return {};
   }
+  const TargetPlaneHomography wall =
+      targetPlaneHomography(a, b, target, K_(0, 0), params_.two_view);
+  if (wall.ok) {
+    const cv::Matx33d back = wall.H.inv();
+    for (int k = 0; k < 4; ++k) {
+      const cv::Vec3d p = back * cv::Vec3d(b[target[k]].x, b[target[k]].y, 1.0);
+      first_view_->corner_sum[k] += cv::Point2d(p[0] / p[2], p[1] / p[2]);
+    }
+    ++first_view_->corner_count;
+  }
+  std::array<cv::Point2d, 4> corners;
+  for (int k = 0; k < 4; ++k) corners[k] = first_view_->corner_sum[k] / first_view_->corner_count;
   const TwoViewInit init =
-      initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view);
-  if (!init.ok) return provisional;
+      initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view, corners);
+  if (!init.ok) return {};
   for (size_t k = 0; k < init.points.size(); ++k) {
     Landmark& l = landmarks_[ids[init.points[k]]];
     l.triangulated = true;
@@ -247,9 +260,20 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
   initialised_ = true;
   first_view_.reset();
   last_pose_ = init.map_from_second;
-  PoseEstimate e{init.map_from_second, PoseSource::kTarget, static_cast<int>(init.points.size()), 0};
+  PoseEstimate e{init.map_from_second, PoseSource::kTarget, static_cast<int>(init.points.size()),
+                 0};
   triangulate(frame, normalized, init.map_from_second);  // anchors for the other tracks
+  forgetOldLandmarks();
   return e;
+}
+
+PoseEstimator::FirstView PoseEstimator::firstView(
+    const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const {
+  FirstView view{frame.ids, normalized, {}, 1};
+  for (size_t i = 0; i < frame.ids.size(); ++i)
+    for (int k = 0; k < 4; ++k)
+      if (frame.ids[i] == target_ids_[k]) view.corner_sum[k] = normalized[i];
+  return view;
 }
 
 void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
@@ -266,8 +290,8 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
       continue;
     }
     if (l.fixed) continue;
-    const double parallax =
-        angleDeg(unitRay(l.anchor_pose, l.anchor_normalized), unitRay(map_from_camera, normalized[i]));
+    const double parallax = angleDeg(unitRay(l.anchor_pose, l.anchor_normalized),
+                                     unitRay(map_from_camera, normalized[i]));
     if (parallax < params_.min_parallax_deg) continue;
     if (l.triangulated && parallax < params_.retriangulate_factor * l.parallax_deg) continue;
     cv::Mat X;

@@ -27,8 +27,7 @@ std::string validateTrackFrame(const TrackFrame& frame) {
       return why.str();
     }
     // OpenCV's convention: pixel centres at integers, the image spans [-0.5, size - 0.5].
-    if (p.x < -0.5 || p.y < -0.5 || p.x > frame.size.width - 0.5 ||
-        p.y > frame.size.height - 0.5) {
+    if (p.x < -0.5 || p.y < -0.5 || p.x > frame.size.width - 0.5 || p.y > frame.size.height - 0.5) {
       why << "point " << i << " (id " << frame.ids[i] << ") at (" << p.x << ", " << p.y
           << ") is outside the " << frame.size.width << "x" << frame.size.height << " image";
       return why.str();

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
-#include "mono_plane_detection/plane_fit.h"
-
 namespace mono_plane_detection {
 namespace {
 
@@ -17,29 +15,43 @@ double median(std::vector<double> v) {
 
 cv::Vec3d rayOf(const cv::Point2d& n) { return cv::Vec3d(n.x, n.y, 1.0); }
 
+cv::Vec3d normalised(const cv::Vec3d& v) { return v / cv::norm(v); }
+
+// second_from_first given the plane's homography H ~ R + t n^T / d (first-camera plane
+// n . x = d, n away from the camera): directions in the plane move with R alone.
+Pose motionFromPlane(cv::Matx33d H, const cv::Vec3d& n, double d) {
+  if (cv::determinant(H) < 0) H = -H;
+  const cv::Vec3d helper = std::abs(n[0]) < 0.9 ? cv::Vec3d(1, 0, 0) : cv::Vec3d(0, 1, 0);
+  const cv::Vec3d v1 = normalised(n.cross(helper)), v2 = n.cross(v1);
+  const cv::Vec3d w1 = H * v1, w2 = H * v2;
+  const double lambda = (cv::norm(w1) + cv::norm(w2)) / 2;
+  // Orthogonal Procrustes on (v1, v2, v1 x v2) -> (w1, w2, w1 x w2).
+  const cv::Vec3d u1 = w1 / lambda, u2 = w2 / lambda, u3 = normalised(u1.cross(u2));
+  const cv::Matx33d M = u1 * v1.t() + u2 * v2.t() + u3 * n.t();
+  cv::Mat W, U, Vt;
+  cv::SVD::compute(cv::Mat(M), W, U, Vt);
+  cv::Matx33d R(cv::Mat(U * Vt));
+  if (cv::determinant(R) < 0) R = -R;
+  const cv::Vec3d t = d * (H * n / lambda - R * n);
+  return {R, t};
+}
+
 }  // namespace
 
-TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
-                                   const std::vector<cv::Point2d>& second,
-                                   const std::array<int, 4>& target, double focal_px,
-                                   const TargetParams& target_params,
-                                   const TwoViewParams& params) {
-  TwoViewInit out;
+TargetPlaneHomography targetPlaneHomography(const std::vector<cv::Point2d>& first,
+                                            const std::vector<cv::Point2d>& second,
+                                            const std::array<int, 4>& target, double focal_px,
+                                            const TwoViewParams& params) {
+  TargetPlaneHomography out;
   const int n = static_cast<int>(first.size());
-  if (n < params.min_inliers || second.size() != first.size()) {
-    out.reason = "too few points seen in both images";
-    return out;
-  }
-  // The target's plane: the largest homography of the tracks that also carries the
-  // target's corners from the first image to the second (a few tries: the floor may be
-  // larger). A homography is well conditioned where the essential matrix is not: indoor
-  // views are often mostly one wall.
-  const double threshold = params.max_error_px / focal_px;
+  if (n != static_cast<int>(second.size())) return out;
   std::vector<bool> active(static_cast<size_t>(n), true);
-  for (int k : target) active[static_cast<size_t>(k)] = false;
-  cv::Matx33d H;
-  std::vector<int> plane_points;
-  for (int attempt = 0; attempt < 3 && plane_points.empty(); ++attempt) {
+  for (int k : target) {
+    if (k < 0 || k >= n) return out;
+    active[static_cast<size_t>(k)] = false;
+  }
+  // A few tries: the floor may be larger than the target's wall.
+  for (int attempt = 0; attempt < 3; ++attempt) {
     std::vector<cv::Point2d> a, b;
     std::vector<int> index;
     for (int i = 0; i < n; ++i)
@@ -50,89 +62,79 @@ TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
       }
     if (static_cast<int>(a.size()) < params.min_inliers) break;
     cv::Mat mask;
-    const cv::Mat found = cv::findHomography(a, b, cv::RANSAC, threshold, mask, 2000, 0.999);
+    const cv::Mat found =
+        cv::findHomography(a, b, cv::RANSAC, params.max_error_px / focal_px, mask, 2000, 0.999);
     if (found.empty()) break;
     std::vector<int> inliers;
     for (size_t k = 0; k < a.size(); ++k)
       if (mask.at<uchar>(static_cast<int>(k))) inliers.push_back(index[k]);
     if (static_cast<int>(inliers.size()) < params.min_inliers) break;
-    const cv::Matx33d candidate(found);
+    const cv::Matx33d H(found);
     double worst = 0;
     for (int k : target) {
-      const cv::Vec3d moved = candidate * rayOf(first[k]);
+      const cv::Vec3d moved = H * rayOf(first[k]);
       worst = std::max(worst, focal_px * std::hypot(moved[0] / moved[2] - second[k].x,
                                                     moved[1] / moved[2] - second[k].y));
     }
     if (worst <= params.max_target_error_px) {
-      H = candidate;
-      plane_points = inliers;
-    } else {
-      for (int i : inliers) active[static_cast<size_t>(i)] = false;
+      out.ok = true;
+      out.H = H;
+      out.inliers = inliers;
+      return out;
     }
+    for (int i : inliers) active[static_cast<size_t>(i)] = false;
   }
-  if (plane_points.empty()) {
+  return out;
+}
+
+TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
+                                   const std::vector<cv::Point2d>& second,
+                                   const std::array<int, 4>& target, double focal_px,
+                                   const TargetParams& target_params, const TwoViewParams& params,
+                                   const std::optional<std::array<cv::Point2d, 4>>& first_corners) {
+  TwoViewInit out;
+  const int n = static_cast<int>(first.size());
+  if (n < params.min_inliers || second.size() != first.size()) {
+    out.reason = "too few points seen in both images";
+    return out;
+  }
+  const TargetPlaneHomography plane =
+      targetPlaneHomography(first, second, target, focal_px, params);
+  if (!plane.ok) {
     out.reason = "no plane of the tracks carries the target";
     return out;
   }
-  std::vector<cv::Mat> rotations, translations, normals;
-  cv::decomposeHomographyMat(cv::Mat(H), cv::Mat::eye(3, 3, CV_64F), rotations, translations,
-                             normals);
-  std::vector<cv::Point2f> before, after;
-  for (int i : plane_points) {
-    before.emplace_back(static_cast<float>(first[i].x), static_cast<float>(first[i].y));
-    after.emplace_back(static_cast<float>(second[i].x), static_cast<float>(second[i].y));
-  }
-  std::vector<int> possible;
-  cv::filterHomographyDecompByVisibleRefpoints(rotations, normals, before, after, possible);
-  if (possible.empty()) {
-    out.reason = "the target's plane homography has no physical decomposition";
-    return out;
-  }
-  // Of the (usually two) remaining solutions, the target's own pose picks the normal.
+  // The first camera from the target's corners (K = identity: normalised coordinates).
   TargetDetection detection;
   detection.found = true;
-  for (int k = 0; k < 4; ++k)
-    detection.corners[k] = cv::Point2f(static_cast<float>(first[target[k]].x),
-                                       static_cast<float>(first[target[k]].y));
-  const auto rough = cameraPoseFromTarget(detection, cv::Matx33d::eye(), cv::Mat(), target_params);
-  const cv::Vec3d rough_normal =
-      rough ? rough->map_from_camera.inverse().R * cv::Vec3d(0, 0, 1) : cv::Vec3d(0, 0, -1);
-  int best = possible.front();
-  double best_angle = 1e9;
-  for (int k : possible) {
-    const cv::Vec3d nk(normals[k]);
-    // OpenCV's normal points away from the camera; the map's z points towards it.
-    const double angle = normalAngleDeg(-nk, rough_normal);
-    if (angle < best_angle) {
-      best_angle = angle;
-      best = k;
-    }
-  }
-  const cv::Matx33d R(rotations[best]);
-  const cv::Vec3d t_over_d(translations[best]);  // second_from_first, in units of d
-  PlaneFit target_plane;
-  target_plane.normal = -cv::Vec3d(normals[best]);
-  target_plane.distance = -1.0;  // plane at unit distance; the target gives the scale below
-  target_plane.ok = true;
-  orientTowards(target_plane, cv::Vec3d(0, 0, 0));
-  const cv::Vec3d t = t_over_d;
-
-  // Corners on that plane, then the scale from the target's known size.
-  std::array<cv::Vec3d, 4> c;
   for (int k = 0; k < 4; ++k) {
-    const cv::Vec3d ray = rayOf(first[target[k]]);
-    c[k] = ray * (target_plane.distance / target_plane.normal.dot(ray));
+    const cv::Point2d c = first_corners ? (*first_corners)[k] : first[target[k]];
+    detection.corners[k] = cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y));
   }
-  const double measured = cv::norm(c[1] - c[0]) + cv::norm(c[2] - c[3]) + cv::norm(c[3] - c[0]) +
-                          cv::norm(c[2] - c[1]);
-  const double scale = 2 * (target_params.width_m + target_params.height_m) / measured;
+  const auto start = cameraPoseFromTarget(detection, cv::Matx33d::eye(), cv::Mat(), target_params);
+  if (!start) {
+    out.reason = "no pose from the target's corners";
+    return out;
+  }
+  out.map_from_first = start->map_from_camera;
+  const Pose first_from_map = out.map_from_first.inverse();
+  const cv::Vec3d toward_plane =
+      -(first_from_map.R * cv::Vec3d(0, 0, 1));  // map z faces the camera
+  const double d = toward_plane.dot(first_from_map.t);
+  if (!(d > 0)) {
+    out.reason = "the target's plane is behind the camera";
+    return out;
+  }
+  const Pose second_from_first = motionFromPlane(plane.H, toward_plane, d);
+  out.map_from_second = out.map_from_first * second_from_first.inverse();
 
   // Every point seen in both views, triangulated with the now known motion.
+  const cv::Matx33d& R = second_from_first.R;
+  const cv::Vec3d& t = second_from_first.t;
   const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
   const cv::Matx34d P2(R(0, 0), R(0, 1), R(0, 2), t[0], R(1, 0), R(1, 1), R(1, 2), t[1], R(2, 0),
                        R(2, 1), R(2, 2), t[2]);
-  std::vector<int> used;
-  std::vector<cv::Vec3d> points;  // first camera's frame, units of d
+  const double threshold = 2 * params.max_error_px / focal_px;
   std::vector<double> parallax;
   for (int i = 0; i < n; ++i) {
     if (std::find(target.begin(), target.end(), i) != target.end()) continue;
@@ -146,14 +148,14 @@ TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
     if (x[2] <= 0 || x2[2] <= 0) continue;
     const double e1 = std::hypot(x[0] / x[2] - first[i].x, x[1] / x[2] - first[i].y);
     const double e2 = std::hypot(x2[0] / x2[2] - second[i].x, x2[1] / x2[2] - second[i].y);
-    if (std::max(e1, e2) > 2 * threshold) continue;
-    const cv::Vec3d r1 = x / cv::norm(x), r2 = R.t() * (x2 / cv::norm(x2));
-    parallax.push_back(std::acos(std::min(1.0, r1.dot(r2))) * 180.0 / CV_PI);
-    used.push_back(i);
-    points.push_back(x);
+    if (std::max(e1, e2) > threshold) continue;
+    parallax.push_back(std::acos(std::min(1.0, normalised(x).dot(R.t() * normalised(x2)))) * 180.0 /
+                       CV_PI);
+    out.points.push_back(i);
+    out.points_map.push_back(out.map_from_first.apply(x));
   }
   out.parallax_deg = median(parallax);
-  if (static_cast<int>(used.size()) < params.min_inliers) {
+  if (static_cast<int>(out.points.size()) < params.min_inliers) {
     out.reason = "too few points triangulate";
     return out;
   }
@@ -161,22 +163,6 @@ TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
     out.reason = "not enough parallax yet";
     return out;
   }
-
-  // Map axes in the first camera's frame: x along the width, z the plane's normal
-  // (towards the camera, into the room), y = z x x.
-  const cv::Vec3d z = target_plane.normal;
-  cv::Vec3d x = (c[1] - c[0]) + (c[2] - c[3]);
-  x -= z * z.dot(x);
-  x /= cv::norm(x);
-  const cv::Vec3d y = z.cross(x);
-  const cv::Vec3d origin = scale * (c[0] + c[1] + c[2] + c[3]) / 4.0;
-  const cv::Matx33d camera_from_map_R(x[0], y[0], z[0], x[1], y[1], z[1], x[2], y[2], z[2]);
-  const Pose camera1_from_map{camera_from_map_R, origin};
-  out.map_from_first = camera1_from_map.inverse();
-  const Pose second_from_first{R, scale * t};
-  out.map_from_second = out.map_from_first * second_from_first.inverse();
-  out.points = used;
-  for (const auto& p : points) out.points_map.push_back(out.map_from_first.apply(scale * p));
   out.ok = true;
   return out;
 }

@@ -113,7 +113,15 @@ PlaneArrayPtr toPlaneArray(const std_msgs::Header& image_header, const std::stri
         if ((it != seen.end()) != (pass == 0)) continue;
         PlaneEstimate out;
         fill(out, plane);
-        if (it != seen.end()) fill(out, *it->second);
+        if (it != seen.end()) {
+          fill(out, *it->second);
+          // Under rotation every plane moves with one homography; report the tracks whose
+          // 3D points the map put on this plane.
+          std::vector<std::uint64_t> on_plane;
+          for (auto id : out.inlier_ids)
+            if (plane.points.count(id)) on_plane.push_back(id);
+          out.inlier_ids.assign(on_plane.begin(), on_plane.end());
+        }
         msg->planes.push_back(out);
       }
   } else {
@@ -215,7 +223,8 @@ sensor_msgs::PointCloud2Ptr toCloud(const std_msgs::Header& header, const PoseEs
     *y = static_cast<float>(l.position[1]);
     *z = static_cast<float>(l.position[2]);
     const auto it = plane_of.find(id);
-    const cv::Scalar bgr = it != plane_of.end() ? planeColour(it->second) : cv::Scalar(200, 200, 200);
+    const cv::Scalar bgr =
+        it != plane_of.end() ? planeColour(it->second) : cv::Scalar(200, 200, 200);
     *r = static_cast<uint8_t>(bgr[2]);
     *g = static_cast<uint8_t>(bgr[1]);
     *b = static_cast<uint8_t>(bgr[0]);

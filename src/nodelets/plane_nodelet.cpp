@@ -2,7 +2,6 @@
 // planes, rviz markers, the map's points, map -> camera tf and a debug image out.
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <opencv2/calib3d.hpp>
 #include <diagnostic_updater/update_functions.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
@@ -15,6 +14,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <opencv2/calib3d.hpp>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "mono_plane_detection/draw_planes.h"
@@ -96,9 +96,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     pnh.param("expected_max_rate_hz", max_rate_, 100.0);
     updater_->add(*rate_diagnostic_);
     updater_->add("planes", this, &PlaneNodelet::diagnose);
-    diagnostic_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) {
-      updater_->update();
-    });
+    diagnostic_timer_ =
+        nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
 
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens).
@@ -162,6 +161,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   void onTracks(const TracksConstPtr& msg) {
+    const ros::WallTime started = ros::WallTime::now();
     std::string error;
     const TrackFrame frame = toTrackFrame(*msg, error);
     if (!error.empty()) {
@@ -184,15 +184,17 @@ class PlaneNodelet : public nodelet::Nodelet {
                               frame.size.height);
       const PipelineResult result = pipeline_->process(frame, odom);
       if (result.was_reset) {
-        NODELET_WARN("tracks stamp %.3f is before the previous one: time went backwards (bag "
-                     "loop?), the map starts over",
-                     frame.stamp);
+        NODELET_WARN(
+            "tracks stamp %.3f is before the previous one: time went backwards (bag "
+            "loop?), the map starts over",
+            frame.stamp);
         markers_shown_.clear();
         reset_markers_ = true;
       }
       if (result.tracking_loss)
-        NODELET_WARN_THROTTLE(5.0, "%.1f s without tracks: tracking lost, waiting for the map "
-                                   "or the target to place the camera again",
+        NODELET_WARN_THROTTLE(5.0,
+                              "%.1f s without tracks: tracking lost, waiting for the map "
+                              "or the target to place the camera again",
                               params_.max_gap_s);
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
@@ -202,6 +204,14 @@ class PlaneNodelet : public nodelet::Nodelet {
       status_ = result.status;
       observed_ = result.planes.size();
       planes = toPlaneArray(msg->header, map_frame_, result, pipeline_->map());
+      if (planes->metric) {
+        const geometry_msgs::TransformStamped pose =
+            toTransform(result.pose->map_from_camera, msg->header, map_frame_, "");
+        planes->camera_pose.position.x = pose.transform.translation.x;
+        planes->camera_pose.position.y = pose.transform.translation.y;
+        planes->camera_pose.position.z = pose.transform.translation.z;
+        planes->camera_pose.orientation = pose.transform.rotation;
+      }
       if (planes->metric) {
         std_msgs::Header map_header = msg->header;
         map_header.frame_id = map_frame_;
@@ -216,16 +226,12 @@ class PlaneNodelet : public nodelet::Nodelet {
         }
         if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
           cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
-        if (publish_tf_) {
-          Pose parent_from_camera = result.pose->map_from_camera;
-          std::string parent = map_frame_;
-          if (odom) {  // map -> odom, so that the robot's own tf tree stays a tree
-            parent_from_camera = result.pose->map_from_camera * odom->inverse();
-            tf = toTransform(parent_from_camera, msg->header, map_frame_, odom_frame_);
-          } else {
-            tf = toTransform(parent_from_camera, msg->header, parent, msg->header.frame_id);
-          }
-        }
+        if (publish_tf_ && odom)  // map -> odom, so that the robot's tf tree stays a tree
+          tf = toTransform(result.pose->map_from_camera * odom->inverse(), msg->header, map_frame_,
+                           odom_frame_);
+        else if (publish_tf_)
+          tf = toTransform(result.pose->map_from_camera, msg->header, map_frame_,
+                           msg->header.frame_id);
       }
       if (debug_pub_.getNumSubscribers() > 0) {
         for (const auto& image : images_)
@@ -239,6 +245,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
     }
     rate_diagnostic_->tick();
+    planes->processing_ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
     planes_pub_.publish(planes);  // shared pointers: no copy inside one manager
     if (markers) markers_pub_.publish(markers);
     if (cloud) cloud_pub_.publish(cloud);
@@ -250,9 +257,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     std::lock_guard<std::mutex> lock(mutex_);
     const bool dropped = dropped_ > 0 || dropped_info_ > 0;
-    status.summary(dropped ? diagnostic_msgs::DiagnosticStatus::WARN
-                           : diagnostic_msgs::DiagnosticStatus::OK,
-                   status_.empty() ? "no tracks yet" : status_);
+    status.summary(
+        dropped ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
+        status_.empty() ? "no tracks yet" : status_);
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);

@@ -39,6 +39,7 @@ PipelineParams readPipelineParams(const ros::NodeHandle& pnh, const std::string&
   // Map.
   pnh.param("plane_max_residual_m", p.map.max_residual_m, p.map.max_residual_m);
   pnh.param("plane_min_points", p.map.min_points, p.map.min_points);
+  pnh.param("plane_min_share", p.map.min_share, p.map.min_share);
   pnh.param("associate_max_angle_deg", p.map.max_angle_deg, p.map.max_angle_deg);
   pnh.param("associate_max_offset_m", p.map.max_offset_m, p.map.max_offset_m);
   pnh.param("confirm_observations", p.map.confirm_observations, p.map.confirm_observations);
@@ -50,8 +51,8 @@ PipelineParams readPipelineParams(const ros::NodeHandle& pnh, const std::string&
   const PipelineParams d;
   auto fix = [&](bool bad, const char* what, auto& value, auto fallback) {
     if (!bad) return;
-    ROS_ERROR_STREAM_NAMED(logger,
-                           "parameter " << what << " = " << value << " is invalid; using " << fallback);
+    ROS_ERROR_STREAM_NAMED(
+        logger, "parameter " << what << " = " << value << " is invalid; using " << fallback);
     value = fallback;
   };
   fix(p.frame_gap < 1, "frame_gap", p.frame_gap, d.frame_gap);

@@ -179,6 +179,7 @@ class TrackerNodelet : public nodelet::Nodelet {
 
   void imageCallback(const sensor_msgs::ImageConstPtr& msg) {
     rate_diagnostic_->tick();
+    const ros::WallTime started = ros::WallTime::now();
     const GreyImage grey = toGrey(msg);
     if (!grey.image) {
       ++dropped_;
@@ -197,7 +198,8 @@ class TrackerNodelet : public nodelet::Nodelet {
         tracker_.reset();
         target_startup_.reset();
       }
-      if (grey.image->image.size() != last_size_) target_startup_.reset();  // the tracker resets too
+      if (grey.image->image.size() != last_size_)
+        target_startup_.reset();  // the tracker resets too
       last_size_ = grey.image->image.size();
       last_stamp_ = msg->header.stamp;
       if (!info_size_.empty() && info_size_ != grey.image->image.size()) {
@@ -218,6 +220,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       lost_ += stats.lost;
       tracked_now_ = static_cast<int>(points.size());
       tracks = toMessage(msg->header, grey.image->image.size(), points, stats.searched);
+      tracks->processing_ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
     }
     tracks_pub_.publish(tracks);  // shared pointer: no copy inside one manager
 
@@ -237,7 +240,9 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("searches (total)", searches_);
     status.add("images dropped (total)", static_cast<long>(dropped_));
     status.add("camera_info", info_size_.empty() ? "none or unusable" : "ok");
-    status.add("start-up target", !detect_target_ ? "not searched" : target_startup_.found() ? "found" : "waiting");
+    status.add("start-up target", !detect_target_           ? "not searched"
+                                  : target_startup_.found() ? "found"
+                                                            : "waiting");
   }
 
   FeatureTracker tracker_;

@@ -13,6 +13,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "mono_plane_detection/map_evaluation.h"
+
 namespace mono_plane_detection {
 namespace {
 
@@ -101,8 +103,18 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
   for (const auto& c : scene.target.corners)
     target["corners_map"].push_back(vec(map_from_world.apply(c)));
   root["target"] = target;
-  for (const auto& p : scene.planes) {
+  // How much of some image each plane covers: the accuracy tests require the planes
+  // that cover at least 10 % of an image.
+  std::vector<double> max_share(scene.planes.size(), 0.0);
+  for (int k = 0; k < spec.frames; ++k) {
+    const Pose world_from_camera = trajectoryPose(spec.trajectory, k / spec.fps);
+    const std::vector<double> shares = imageShares(scene, spec.camera, world_from_camera, 16);
+    for (size_t i = 0; i < shares.size(); ++i) max_share[i] = std::max(max_share[i], shares[i]);
+  }
+  for (size_t i = 0; i < scene.planes.size(); ++i) {
+    const ScenePlane& p = scene.planes[i];
     YAML::Node plane;
+    plane["max_image_share"] = max_share[i];
     plane["id"] = p.id;
     plane["name"] = p.name;
     const cv::Vec3d n = map_from_world.R * p.normal();

@@ -172,21 +172,24 @@ int main(int argc, char** argv) {
       }
       tracking += result.state == PipelineState::kTracking;
       if (report_every > 0 && (k + 1) % report_every == 0)
-        std::printf("  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
-                    "position error %.3f m\n",
-                    k + 1, result.status.c_str(), result.planes.size(),
-                    pipeline.map().planes().size(), frame.ids.size(), frame_err);
+        std::printf(
+            "  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
+            "position error %.3f m\n",
+            k + 1, result.status.c_str(), result.planes.size(), pipeline.map().planes().size(),
+            frame.ids.size(), frame_err);
     }
     const double rss = currentRssMb();
-    std::printf("loop %d: tracker %.2f ms/frame, planes+map %.2f ms/frame, RSS %.1f MB "
-                "(start %.1f), landmarks %zu, map planes %zu\n",
-                loop + 1, track_ms / frames, plane_ms / frames, rss, start_rss,
-                pipeline.poseEstimator()->landmarks().size(), pipeline.map().planes().size());
+    std::printf(
+        "loop %d: tracker %.2f ms/frame, planes+map %.2f ms/frame, RSS %.1f MB "
+        "(start %.1f), landmarks %zu, map planes %zu\n",
+        loop + 1, track_ms / frames, plane_ms / frames, rss, start_rss,
+        pipeline.poseEstimator()->landmarks().size(), pipeline.map().planes().size());
     if (loop + 1 < loops) continue;
-    std::printf("camera: placed in %d/%d frames, position error mean %.3f m, max %.3f m, "
-                "travelled %.2f m (max error %.1f %% of it)\n",
-                posed, frames, posed ? pos_err_sum / posed : 0.0, pos_err_max, travelled,
-                travelled > 0 ? 100 * pos_err_max / travelled : 0.0);
+    std::printf(
+        "camera: placed in %d/%d frames, position error mean %.3f m, max %.3f m, "
+        "travelled %.2f m (max error %.1f %% of it)\n",
+        posed, frames, posed ? pos_err_sum / posed : 0.0, pos_err_max, travelled,
+        travelled > 0 ? 100 * pos_err_max / travelled : 0.0);
     std::vector<MapPlane> confirmed;
     for (const MapPlane& p : pipeline.map().planes())
       if (p.confirmed(pipeline.map().params())) confirmed.push_back(p);
@@ -196,11 +199,12 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < confirmed.size(); ++i) {
       const MapPlane& p = confirmed[i];
       const PlaneMatch& m = eval.matches[i];
-      std::printf("  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
-                  "(normal %.2f deg, distance %.3f m)\n",
-                  p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(),
-                  p.observations, m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH",
-                  m.normal_error_deg, m.distance_error_m);
+      std::printf(
+          "  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
+          "(normal %.2f deg, distance %.3f m)\n",
+          p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(), p.observations,
+          m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH", m.normal_error_deg,
+          m.distance_error_m);
     }
     for (const TruthPlane& t : truth)
       std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),

@@ -1,0 +1,88 @@
+#include "ground_truth.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace mono_plane_detection {
+namespace {
+
+cv::Vec3d vec3(const YAML::Node& n) {
+  return {n[0].as<double>(), n[1].as<double>(), n[2].as<double>()};
+}
+
+}  // namespace
+
+Pose poseOf(const geometry_msgs::Pose& pose) {
+  const double w = pose.orientation.w, x = pose.orientation.x, y = pose.orientation.y,
+               z = pose.orientation.z;
+  Pose p;
+  p.R = cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
+                    2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
+                    2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
+  p.t = cv::Vec3d(pose.position.x, pose.position.y, pose.position.z);
+  return p;
+}
+
+GroundTruth loadGroundTruth(const std::string& yaml_path) {
+  GroundTruth truth;
+  try {
+    const YAML::Node root = YAML::LoadFile(yaml_path);
+    truth.trajectory = root["trajectory"] ? root["trajectory"].as<std::string>() : "";
+    for (const auto& p : root["planes"]) {
+      TruthPlane t;
+      t.id = p["id"].as<int>();
+      t.name = p["name"].as<std::string>();
+      t.normal = vec3(p["normal"]);
+      t.distance = p["distance_m"].as<double>();
+      t.max_image_share = p["max_image_share"] ? p["max_image_share"].as<double>() : 1.0;
+      truth.planes.push_back(t);
+    }
+    for (const auto& c : root["target"]["corners_map"]) truth.target_corners.push_back(vec3(c));
+    for (const auto& e : root["camera_gt_in_map"]) {
+      geometry_msgs::Pose pose;
+      const cv::Vec3d t = vec3(e["position"]);
+      pose.position.x = t[0];
+      pose.position.y = t[1];
+      pose.position.z = t[2];
+      pose.orientation.x = e["orientation_xyzw"][0].as<double>();
+      pose.orientation.y = e["orientation_xyzw"][1].as<double>();
+      pose.orientation.z = e["orientation_xyzw"][2].as<double>();
+      pose.orientation.w = e["orientation_xyzw"][3].as<double>();
+      if (!truth.poses.empty()) truth.travelled_m += cv::norm(t - truth.poses.back().t);
+      truth.stamps.push_back(e["stamp"].as<double>());
+      truth.poses.push_back(poseOf(pose));
+    }
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("cannot read ground truth " + yaml_path + ": " + e.what());
+  }
+  if (truth.planes.empty() || truth.poses.empty())
+    throw std::runtime_error("ground truth " + yaml_path + " has no planes or poses");
+  return truth;
+}
+
+std::optional<Pose> poseAt(const GroundTruth& truth, double stamp) {
+  for (size_t i = 0; i < truth.stamps.size(); ++i)
+    if (std::abs(truth.stamps[i] - stamp) < 1e-3) return truth.poses[i];
+  return {};
+}
+
+std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm) {
+  std::vector<MapPlane> out;
+  for (const auto& p : msg.planes) {
+    if (!p.metric || static_cast<int>(p.observations) < confirm) continue;
+    MapPlane m;
+    m.id = p.id;
+    m.normal = cv::Vec3d(p.normal.x, p.normal.y, p.normal.z);
+    m.distance = p.distance;
+    for (const auto& v : p.polygon) m.polygon.emplace_back(v.x, v.y, v.z);
+    m.observations = static_cast<int>(p.observations);
+    m.confidence = p.confidence;
+    m.rms_m = p.rms_m;
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace mono_plane_detection
