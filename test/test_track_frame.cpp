@@ -13,7 +13,7 @@ TrackFrame good() {
   TrackFrame f;
   f.size = {640, 480};
   f.ids = {1, 2, 3};
-  f.pixels = {{10, 10}, {639.4, 479.4}, {-0.4, 0}};
+  f.pixels = {{10, 10}, {641.4, 481.4}, {-2.4, 0}};  // within the 2 px border margin
   f.target_corner = {false, false, true};
   return f;
 }
@@ -36,6 +36,9 @@ TEST(TrackFrame, NamesWhatIsWrong) {
   f.pixels[0] = {700, 10};
   EXPECT_NE(validateTrackFrame(f).find("outside"), std::string::npos);
   f = good();
+  f.pixels[0] = {10, 481.6};  // just beyond the margin
+  EXPECT_NE(validateTrackFrame(f).find("outside"), std::string::npos);
+  f = good();
   f.ids[2] = 1;
   EXPECT_NE(validateTrackFrame(f).find("appears twice"), std::string::npos);
   f = good();
@@ -56,7 +59,7 @@ TEST(TrackFrame, MatchByIdPairsTheSamePoints) {
   const Correspondences c = matchById(a, b);
   ASSERT_EQ(c.ids.size(), 2u);
   EXPECT_EQ(c.ids[0], 3u);
-  EXPECT_EQ(c.first[0], cv::Point2d(-0.4, 0));
+  EXPECT_EQ(c.first[0], cv::Point2d(-2.4, 0));
   EXPECT_EQ(c.second[0], cv::Point2d(5, 5));
   EXPECT_EQ(c.ids[1], 1u);
   EXPECT_EQ(c.first[1], cv::Point2d(10, 10));

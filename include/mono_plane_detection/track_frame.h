@@ -17,8 +17,12 @@ struct TrackFrame {
   std::vector<bool> target_corner;  // corner of the start-up target
 };
 
+// Points may lie this far outside the image (sub-pixel refinement at the border).
+constexpr double kTrackBorderMarginPx = 2.0;
+
 // Empty when the frame is usable; otherwise why not (array lengths differ, a coordinate
-// is not finite or outside the image, an id repeats, the image size is zero).
+// is not finite or more than kTrackBorderMarginPx outside the image, an id repeats, the
+// image size is zero).
 std::string validateTrackFrame(const TrackFrame& frame);
 
 // Pixel pairs of the points seen in both frames, matched by track id, with the ids.

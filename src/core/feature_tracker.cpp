@@ -188,6 +188,10 @@ void FeatureTracker::search(const cv::Mat& gray) {
   }
   if (!corners.empty()) {
     cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
+    // Refinement can push a border corner just outside the image.
+    corners.erase(std::remove_if(corners.begin(), corners.end(),
+                                 [&](const cv::Point2f& c) { return !inside(c, gray.size()); }),
+                  corners.end());
   }
 
   // Matched corners are the same physical point as a live one: the live point keeps

@@ -26,8 +26,11 @@ std::string validateTrackFrame(const TrackFrame& frame) {
       why << "point " << i << " (id " << frame.ids[i] << ") has a non-finite coordinate";
       return why.str();
     }
-    // OpenCV's convention: pixel centres at integers, the image spans [-0.5, size - 0.5].
-    if (p.x < -0.5 || p.y < -0.5 || p.x > frame.size.width - 0.5 || p.y > frame.size.height - 0.5) {
+    // OpenCV's convention: pixel centres at integers, the image spans [-0.5, size - 0.5];
+    // trackers' sub-pixel refinement may end a little outside, which is tolerated.
+    const double margin = kTrackBorderMarginPx + 0.5;
+    if (p.x < -margin || p.y < -margin || p.x > frame.size.width - 1 + margin ||
+        p.y > frame.size.height - 1 + margin) {
       why << "point " << i << " (id " << frame.ids[i] << ") at (" << p.x << ", " << p.y
           << ") is outside the " << frame.size.width << "x" << frame.size.height << " image";
       return why.str();
