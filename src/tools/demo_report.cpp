@@ -184,9 +184,14 @@ class Report {
         for (auto id : p.inlier_ids) plane_of[id] = p.id;
     for (size_t i = 0; i < tracks->id.size(); ++i) {
       const auto it = plane_of.find(tracks->id[i]);
-      const cv::Scalar colour =
-          it != plane_of.end() ? planeColour(it->second) : cv::Scalar(128, 128, 128);
-      cv::circle(out, cv::Point2f(tracks->u[i], tracks->v[i]), 4, colour, cv::FILLED, cv::LINE_AA);
+      const cv::Point2f at(tracks->u[i], tracks->v[i]);
+      if (it == plane_of.end()) {  // on no plane: a hollow white ring
+        cv::circle(out, at, 4, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+        cv::circle(out, at, 4, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+      } else {
+        cv::circle(out, at, 5, cv::Scalar(0, 0, 0), cv::FILLED, cv::LINE_AA);
+        cv::circle(out, at, 4, planeColour(it->second), cv::FILLED, cv::LINE_AA);
+      }
     }
     cv::putText(out, planes->status, {8, 20}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {255, 255, 255}, 1,
                 cv::LINE_AA);
