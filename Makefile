@@ -3,7 +3,7 @@
 #                run the whole pipeline on it headless, print and write the results
 #   make test    install deps, build, run every gtest and rostest, print a summary
 #   make build   install deps and build the catkin workspace under build/ws
-#   make bench   run the benchmark programs (figures, never pass/fail)
+#   make bench   the benchmark suite and end-to-end latency (figures, never pass/fail)
 #   make eval    segment_planes on the AdelaideRMF dev scenes (DATA=folder)
 #   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
 #   make clean   remove build/
@@ -54,9 +54,12 @@ test: build
 	@$(CATKIN) run_tests -j1 > $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
 	@scripts/summarize_tests.sh $(WS)/build/test_results
 
+# The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
+# through the nodelet manager. BENCH_ALL=1 adds the older per-switch tables.
 bench: build
-	@source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker
-	@source $(DEVEL) && rosrun mono_plane_detection benchmark_planes
+	@source $(DEVEL) && scripts/benchmark.sh $(RESULTS)
+	@[ "$(BENCH_ALL)" != 1 ] || { source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker \
+	  && rosrun mono_plane_detection benchmark_planes; }
 
 eval: build
 	@source $(DEVEL) && scripts/eval_two_view $(DATA)

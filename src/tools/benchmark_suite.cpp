@@ -1,0 +1,272 @@
+// The benchmark suite (make bench): our tracker and plane stage against plain baselines
+// doing the same work in the same run, on generated frames, one thread. Prints a table
+// with ours / baseline for every row and writes a plot (time against points).
+// A measurement, never a test.
+//   rosrun mono_plane_detection benchmark_suite [--frames N] [--repeats N] [--plot file.png]
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <string>
+#include <vector>
+
+#include "mono_plane_detection/feature_tracker.h"
+#include "mono_plane_detection/homography_voting.h"
+#include "mono_plane_detection/synthetic_two_view.h"
+#include "mono_plane_detection/synthetic_views.h"
+
+using namespace mono_plane_detection;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct Stats {
+  double mean = 0, p95 = 0;
+};
+
+Stats stats(std::vector<double> v) {
+  Stats s;
+  if (v.empty()) return s;
+  for (double x : v) s.mean += x / v.size();
+  std::sort(v.begin(), v.end());
+  s.p95 = v[std::min(v.size() - 1, v.size() * 95 / 100)];
+  return s;
+}
+
+// Frames of a texture drifting and turning slowly (the "easy" motion of benchmark_tracker).
+std::vector<cv::Mat> frames(const cv::Size& size, int count) {
+  const cv::Mat texture = makeCornerTexture({size.width * 2, size.height * 2}, 42);
+  std::vector<cv::Mat> out;
+  cv::RNG rng(7);
+  for (int k = 0; k < count; ++k) {
+    const cv::Point2d shift(-size.width / 2.0 + 1.5 * k, -size.height / 2.0 + 0.5 * k);
+    cv::Mat view = warpView(texture, similarity(0.002 * k, {size.width / 2.0, size.height / 2.0},
+                                                shift),
+                            size);
+    cv::Mat noise(view.size(), CV_16SC1);
+    rng.fill(noise, cv::RNG::NORMAL, 0, 3);
+    cv::Mat noisy;
+    view.convertTo(noisy, CV_16SC1);
+    noisy += noise;
+    noisy.convertTo(view, CV_8UC1);
+    out.push_back(view);
+  }
+  return out;
+}
+
+// Our tracker, per-frame times.
+std::vector<double> timeTracker(const std::vector<cv::Mat>& images, int features) {
+  TrackerParams p;
+  p.max_features = features;
+  FeatureTracker tracker(p);
+  std::vector<double> t;
+  for (const cv::Mat& image : images) {
+    const auto start = Clock::now();
+    tracker.process(image);
+    t.push_back(msSince(start));
+  }
+  return t;
+}
+
+// The floor cost of tracking: goodFeaturesToTrack every 10 images, LK in between, same
+// pyramid and window, no ids, no checks, no matching.
+std::vector<double> timeBaselineTracker(const std::vector<cv::Mat>& images, int features) {
+  const TrackerParams p;
+  std::vector<double> t;
+  std::vector<cv::Point2f> points;
+  cv::Mat previous;
+  for (size_t k = 0; k < images.size(); ++k) {
+    const auto start = Clock::now();
+    if (k % 10 == 0 || points.size() < static_cast<size_t>(features) / 3) {
+      cv::goodFeaturesToTrack(images[k], points, features, p.quality_level, p.min_distance_px);
+    } else {
+      std::vector<cv::Point2f> next;
+      std::vector<uchar> status;
+      std::vector<float> error;
+      cv::calcOpticalFlowPyrLK(previous, images[k], points, next, status, error,
+                               cv::Size(p.window_size_px, p.window_size_px),
+                               p.pyramid_levels - 1);
+      points.clear();
+      for (size_t i = 0; i < next.size(); ++i)
+        if (status[i]) points.push_back(next[i]);
+    }
+    previous = images[k];
+    t.push_back(msSince(start));
+  }
+  return t;
+}
+
+// A plane detector a user might pick instead: MAGSAC homography, remove its inliers,
+// repeat while a plane with min_support points is found.
+std::vector<int> sequentialMagsac(const std::vector<cv::Point2d>& a,
+                                  const std::vector<cv::Point2d>& b, double threshold,
+                                  int min_support, int max_planes) {
+  std::vector<int> labels(a.size(), 0), remaining(a.size());
+  for (size_t i = 0; i < a.size(); ++i) remaining[i] = static_cast<int>(i);
+  for (int plane = 1; plane <= max_planes && static_cast<int>(remaining.size()) >= min_support;
+       ++plane) {
+    std::vector<cv::Point2d> ra, rb;
+    for (int i : remaining) {
+      ra.push_back(a[i]);
+      rb.push_back(b[i]);
+    }
+    cv::Mat mask;
+    const cv::Mat H = cv::findHomography(ra, rb, cv::USAC_MAGSAC, threshold, mask, 1000, 0.99);
+    if (H.empty() || cv::countNonZero(mask) < min_support) break;
+    std::vector<int> rest;
+    for (size_t k = 0; k < remaining.size(); ++k)
+      (mask.at<uchar>(static_cast<int>(k)) ? labels[remaining[k]] = plane, void()
+                                            : rest.push_back(remaining[k]));
+    remaining.swap(rest);
+  }
+  return labels;
+}
+
+struct PlaneRow {
+  int points;
+  Stats ours, baseline;
+  double our_error, baseline_error;  // misclassification, %
+};
+
+PlaneRow benchPlanes(int points, int repeats) {
+  PlaneRow row{points, {}, {}, 0, 0};
+  std::vector<double> ours, base;
+  for (int r = 0; r < repeats; ++r) {
+    TwoViewSceneParams sp;
+    sp.planes = 3;
+    sp.outlier_fraction = 0.2;
+    sp.points_per_plane = static_cast<int>(points * 0.8 / 3);
+    sp.seed = 100 + r;
+    const auto scene = makeTwoViewScene(sp);
+    PlaneParams params;
+    params.vote_threshold_px = 4.0 * sp.noise_px;
+    auto start = Clock::now();
+    const auto result = segmentPlanes(scene.view1, scene.view2, params);
+    ours.push_back(msSince(start));
+    start = Clock::now();
+    const auto labels = sequentialMagsac(scene.view1, scene.view2, params.vote_threshold_px,
+                                         params.min_plane_support, params.max_planes);
+    base.push_back(msSince(start));
+    row.our_error += 100 * misclassificationError(scene.labels, result.labels) / repeats;
+    row.baseline_error += 100 * misclassificationError(scene.labels, labels) / repeats;
+  }
+  row.ours = stats(ours);
+  row.baseline = stats(base);
+  return row;
+}
+
+// Time against points, both stages, ours solid and baselines dashed (log-free, linear).
+void plot(const std::vector<PlaneRow>& planes,
+          const std::vector<std::pair<int, std::pair<double, double>>>& tracker,
+          const std::string& path) {
+  const int w = 720, h = 420, left = 60, bottom = 50, top = 40, right = 20;
+  cv::Mat img(h, w, CV_8UC3, cv::Scalar(255, 255, 255));
+  double max_ms = 1;
+  for (const auto& r : planes) max_ms = std::max({max_ms, r.ours.mean, r.baseline.mean});
+  for (const auto& r : tracker) max_ms = std::max({max_ms, r.second.first, r.second.second});
+  const double max_points = 1000;
+  auto at = [&](double points, double ms) {
+    return cv::Point(cvRound(left + (w - left - right) * points / max_points),
+                     cvRound(h - bottom - (h - bottom - top) * ms / (1.1 * max_ms)));
+  };
+  cv::line(img, at(0, 0), at(max_points, 0), {0, 0, 0});
+  cv::line(img, at(0, 0), at(0, 1.1 * max_ms), {0, 0, 0});
+  for (int p = 0; p <= 1000; p += 250)
+    cv::putText(img, std::to_string(p), at(p, 0) + cv::Point(-10, 18), cv::FONT_HERSHEY_SIMPLEX,
+                0.4, {0, 0, 0});
+  for (int k = 0; k <= 4; ++k) {
+    const double ms = 1.1 * max_ms * k / 4;
+    cv::putText(img, cv::format("%.0f", ms), at(0, ms) + cv::Point(-40, 4),
+                cv::FONT_HERSHEY_SIMPLEX, 0.4, {0, 0, 0});
+  }
+  auto series = [&](const std::vector<cv::Point>& pts, const cv::Scalar& colour, bool dashed) {
+    for (size_t i = 1; i < pts.size(); ++i) {
+      if (!dashed) {
+        cv::line(img, pts[i - 1], pts[i], colour, 2, cv::LINE_AA);
+        continue;
+      }
+      for (double s = 0; s < 1; s += 0.1)
+        cv::line(img, pts[i - 1] + (pts[i] - pts[i - 1]) * s,
+                 pts[i - 1] + (pts[i] - pts[i - 1]) * (s + 0.05), colour, 2, cv::LINE_AA);
+    }
+    for (const auto& p : pts) cv::circle(img, p, 3, colour, cv::FILLED);
+  };
+  std::vector<cv::Point> po, pb, to, tb;
+  for (const auto& r : planes) {
+    po.push_back(at(r.points, r.ours.mean));
+    pb.push_back(at(r.points, r.baseline.mean));
+  }
+  for (const auto& r : tracker) {
+    to.push_back(at(r.first, r.second.first));
+    tb.push_back(at(r.first, r.second.second));
+  }
+  series(po, {200, 0, 0}, false);
+  series(pb, {200, 0, 0}, true);
+  series(to, {0, 0, 200}, false);
+  series(tb, {0, 0, 200}, true);
+  cv::putText(img, "ms per frame vs points (640x480 for tracking), one thread", {left, 20},
+              cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0}, 1, cv::LINE_AA);
+  cv::putText(img, "blue: planes (ours solid, sequential MAGSAC dashed)", {left, h - 22},
+              cv::FONT_HERSHEY_SIMPLEX, 0.4, {200, 0, 0}, 1, cv::LINE_AA);
+  cv::putText(img, "red: tracker (ours solid, GFTT + LK dashed)", {left, h - 8},
+              cv::FONT_HERSHEY_SIMPLEX, 0.4, {0, 0, 200}, 1, cv::LINE_AA);
+  cv::imwrite(path, img);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int count = 100, repeats = 20;
+  std::string plot_path = "benchmark.png";
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) count = std::max(20, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--plot") && i + 1 < argc) plot_path = argv[++i];
+    else {
+      std::printf("usage: benchmark_suite [--frames N] [--repeats N] [--plot file.png]\n");
+      return std::strcmp(argv[i], "--help") ? 2 : 0;
+    }
+  }
+  cv::setNumThreads(1);
+  std::printf("benchmark_suite: one thread; %d generated frames per tracker row, %d scenes per "
+              "plane row.\n\n",
+              count, repeats);
+  std::printf("Tracker (ours) against goodFeaturesToTrack + calcOpticalFlowPyrLK (baseline),\n"
+              "ms per frame, mean / p95:\n");
+  std::printf("  %-10s %6s %16s %16s %8s\n", "image", "feat.", "ours", "baseline", "ratio");
+  std::vector<std::pair<int, std::pair<double, double>>> tracker_vga;
+  for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480), cv::Size(1280, 720)}) {
+    const std::vector<cv::Mat> images = frames(size, count);
+    for (int features : {50, 150, 500}) {
+      const Stats ours = stats(timeTracker(images, features));
+      const Stats base = stats(timeBaselineTracker(images, features));
+      std::printf("  %4dx%-5d %6d %7.2f / %6.2f %7.2f / %6.2f %7.2fx\n", size.width, size.height,
+                  features, ours.mean, ours.p95, base.mean, base.p95, ours.mean / base.mean);
+      if (size.width == 640) tracker_vga.push_back({features, {ours.mean, base.mean}});
+    }
+  }
+  std::printf("\nPlane stage (segmentPlanes) against sequential MAGSAC (cv::findHomography\n"
+              "USAC_MAGSAC, remove inliers, repeat), 3 planes, 20 %% outliers, 0.7 px noise,\n"
+              "threshold 2.8 px. ms per frame mean / p95, misclassification error:\n");
+  std::printf("  %6s %16s %16s %8s %9s %9s\n", "points", "ours", "baseline", "ratio",
+              "ours err", "base err");
+  std::vector<PlaneRow> rows;
+  for (int points : {50, 200, 500, 1000}) {
+    const PlaneRow r = benchPlanes(points, repeats);
+    rows.push_back(r);
+    std::printf("  %6d %7.2f / %6.2f %7.2f / %6.2f %7.2fx %8.1f%% %8.1f%%\n", r.points, r.ours.mean,
+                r.ours.p95, r.baseline.mean, r.baseline.p95, r.ours.mean / r.baseline.mean,
+                r.our_error, r.baseline_error);
+  }
+  plot(rows, tracker_vga, plot_path);
+  std::printf("\nplot: %s\n", plot_path.c_str());
+  return 0;
+}
