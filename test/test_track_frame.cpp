@@ -56,7 +56,7 @@ TEST(TrackFrame, MatchByIdPairsTheSamePoints) {
   TrackFrame a = good(), b = good();
   b.ids = {3, 9, 1};
   b.pixels = {{5, 5}, {6, 6}, {7, 7}};
-  const Correspondences c = matchById(a, b);
+  const TrackPairs c = matchById(a, b);
   ASSERT_EQ(c.ids.size(), 2u);
   EXPECT_EQ(c.ids[0], 3u);
   EXPECT_EQ(c.first[0], cv::Point2d(-2.4, 0));

@@ -18,7 +18,7 @@ struct Pair {
 };
 
 Pair pairOf(const SyntheticTracks& world, const TrackFrame& f1, const TrackFrame& f2) {
-  const Correspondences c = matchById(f1, f2);
+  const TrackPairs c = matchById(f1, f2);
   Pair p;
   cv::undistortPoints(c.first, p.a, world.camera.K(), world.camera.distortion());
   cv::undistortPoints(c.second, p.b, world.camera.K(), world.camera.distortion());

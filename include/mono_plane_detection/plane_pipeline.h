@@ -49,7 +49,7 @@ struct PipelineResult {
   std::optional<PoseEstimate> pose;  // this image's camera in the map
   std::vector<ImagePlane> planes;    // largest first
   double reference_stamp = -1;       // image the homographies start from, -1 none
-  Correspondences pairs;             // reference/current pixels the planes were found in
+  TrackPairs pairs;             // reference/current pixels the planes were found in
   PlaneSegmentation segmentation;    // over `pairs`
 };
 

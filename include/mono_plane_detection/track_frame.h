@@ -26,10 +26,10 @@ constexpr double kTrackBorderMarginPx = 2.0;
 std::string validateTrackFrame(const TrackFrame& frame);
 
 // Pixel pairs of the points seen in both frames, matched by track id, with the ids.
-struct Correspondences {
+struct TrackPairs {
   std::vector<std::uint64_t> ids;
   std::vector<cv::Point2d> first, second;
 };
-Correspondences matchById(const TrackFrame& first, const TrackFrame& second);
+TrackPairs matchById(const TrackFrame& first, const TrackFrame& second);
 
 }  // namespace mono_plane_detection

@@ -43,11 +43,11 @@ std::string validateTrackFrame(const TrackFrame& frame) {
   return {};
 }
 
-Correspondences matchById(const TrackFrame& first, const TrackFrame& second) {
+TrackPairs matchById(const TrackFrame& first, const TrackFrame& second) {
   std::unordered_map<std::uint64_t, size_t> index;
   index.reserve(first.ids.size());
   for (size_t i = 0; i < first.ids.size(); ++i) index.emplace(first.ids[i], i);
-  Correspondences out;
+  TrackPairs out;
   for (size_t j = 0; j < second.ids.size(); ++j) {
     const auto it = index.find(second.ids[j]);
     if (it == index.end()) continue;
