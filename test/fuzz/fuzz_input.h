@@ -11,12 +11,16 @@ class FuzzInput {
  public:
   FuzzInput(const uint8_t* data, size_t size) : data_(data), size_(size) {}
   bool empty() const { return pos_ >= size_; }
-  size_t left() const { return size_ - pos_; }
+  size_t left() const { return pos_ < size_ ? size_ - pos_ : 0; }
   // Any float bit pattern, NaN and infinities included; 0 when the bytes run out.
   double nextFloat() {
     float f = 0;
-    if (left() >= sizeof f) std::memcpy(&f, data_ + pos_, sizeof f);
-    pos_ += sizeof f;
+    if (left() >= sizeof f) {
+      std::memcpy(&f, data_ + pos_, sizeof f);
+      pos_ += sizeof f;
+    } else {
+      pos_ = size_;
+    }
     return f;
   }
   uint8_t nextByte() { return pos_ < size_ ? data_[pos_++] : 0; }
