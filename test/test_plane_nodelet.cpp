@@ -8,6 +8,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -16,6 +17,8 @@
 
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
+#include <opencv2/calib3d.hpp>
+
 #include "mono_plane_detection/plane_fit.h"
 #include "synthetic_tracks.h"
 
@@ -303,6 +306,59 @@ TEST_F(PlaneNodeletTest, H_WithoutCameraInfoThePlanesStayInTheImage) {
   ASSERT_TRUE(r);
   EXPECT_FALSE(r->metric);
   for (const auto& p : r->planes) EXPECT_FALSE(p.metric);
+}
+
+// The robot's odometry: tf odom -> camera_optical for every image (the true pose seen
+// from an odometry origin 1 m aside and turned). The nodelet must take the pose from it
+// once the start has fixed map -> odom, and publish map -> odom.
+TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
+  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
+      "planes_odom", 50, [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  tf2_ros::TransformBroadcaster broadcaster;
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(10);
+  while (tracks.getNumSubscribers() == 0 && ros::WallTime::now() < ready) {
+    ros::spinOnce();
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
+  PlaneArrayConstPtr last;
+  for (int k = 0; k < 90; ++k) {
+    const double t = k / 30.0;
+    TrackFrame f = world_->frame(t);
+    f.stamp += 500;  // its own time line
+    const Pose odom = odom_from_map * world_->truthMapFromCamera(t);
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(f.stamp);
+    tf.header.frame_id = "odom";
+    tf.child_frame_id = "camera_optical";
+    tf.transform.translation.x = odom.t[0];
+    tf.transform.translation.y = odom.t[1];
+    tf.transform.translation.z = odom.t[2];
+    cv::Vec3d r;
+    cv::Rodrigues(odom.R, r);
+    const double angle = cv::norm(r);
+    const cv::Vec3d axis = angle > 1e-12 ? r / angle : cv::Vec3d(1, 0, 0);
+    tf.transform.rotation.w = std::cos(angle / 2);
+    tf.transform.rotation.x = axis[0] * std::sin(angle / 2);
+    tf.transform.rotation.y = axis[1] * std::sin(angle / 2);
+    tf.transform.rotation.z = axis[2] * std::sin(angle / 2);
+    broadcaster.sendTransform(tf);
+    ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    tracks.publish(toTracks(f));
+    last = waitFor(answers, ros::Time(f.stamp).toNSec());
+    ASSERT_TRUE(last) << "image " << k;
+  }
+  EXPECT_EQ(last->status, "tracking (odometry)");
+  const Pose truth = world_->truthMapFromCamera(89 / 30.0);
+  EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
+  EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0), ros::Duration(2.0)));
 }
 
 }  // namespace
