@@ -188,6 +188,65 @@ TEST_F(TrackerNodeletTest, BlackTinyAndResizedImages) {
   for (auto f : resized->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
 }
 
+TEST_F(TrackerNodeletTest, WhiteOddHugeAndBigEndianImages) {
+  // All white and saturated: no corners, an empty answer.
+  auto white = send(makeImage(cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(white);
+  EXPECT_TRUE(white->id.empty());
+  // An odd size.
+  cv::Mat odd;
+  cv::resize(view({0, 0}), odd, {641, 479});
+  auto odd_tracks = send(makeImage(odd, "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(odd_tracks);
+  EXPECT_EQ(odd_tracks->width, 641u);
+  EXPECT_FALSE(odd_tracks->id.empty());
+  // A huge frame is still answered (slowly).
+  cv::Mat huge;
+  cv::resize(view({0, 0}), huge, {4096, 3072}, 0, 0, cv::INTER_LINEAR);
+  const ros::WallTime start = ros::WallTime::now();
+  auto huge_tracks = send(makeImage(huge, "mono8", stamp_ += 0.1), 30.0);
+  ASSERT_TRUE(huge_tracks);
+  EXPECT_EQ(huge_tracks->width, 4096u);
+  EXPECT_FALSE(huge_tracks->id.empty());
+  std::printf("4096x3072: answered in %.0f ms\n", (ros::WallTime::now() - start).toSec() * 1e3);
+  // Big-endian mono16: the bytes of each pixel swapped, the same view.
+  cv::Mat wide;
+  view({0, 0}).convertTo(wide, CV_16U, 256.0);
+  auto big = makeImage(wide, "mono16", stamp_ += 0.1);
+  big->is_bigendian = 1;
+  for (size_t i = 0; i + 1 < big->data.size(); i += 2) std::swap(big->data[i], big->data[i + 1]);
+  auto big_tracks = send(big);
+  ASSERT_TRUE(big_tracks);
+  auto little_tracks = send(makeImage(wide, "mono16", stamp_ += 0.1));
+  ASSERT_TRUE(little_tracks);
+  // Read right, the big-endian image is the same view: its points are tracked on.
+  int tracked = 0;
+  for (auto f : little_tracks->flags) tracked += (f & Tracks::FLAG_TRACKED) != 0;
+  EXPECT_GE(tracked, 45);
+}
+
+TEST_F(TrackerNodeletTest, DuplicateStampsGapsAndEmptyFrameIds) {
+  auto first = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(first);
+  // The same stamp again: dropped.
+  received_.clear();
+  auto again = makeImage(view({0.5, 0}), "mono8", stamp_);
+  EXPECT_FALSE(send(again, 1.0));
+  // After a 2 s pause: tracking starts over (every point new).
+  auto after_gap = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 2.0));
+  ASSERT_TRUE(after_gap);
+  for (auto f : after_gap->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+  // An empty frame_id is passed on (with a warning), tracking goes on.
+  auto unnamed = makeImage(view({1, 0}), "mono8", stamp_ += 0.1);
+  unnamed->header.frame_id.clear();
+  auto tracks = send(unnamed);
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->header.frame_id, "");
+  int tracked = 0;
+  for (auto f : tracks->flags) tracked += (f & Tracks::FLAG_TRACKED) != 0;
+  EXPECT_GE(tracked, 45);
+}
+
 TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
   ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1)));
   auto same = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));

@@ -66,22 +66,23 @@ std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const
 std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
                                                   const std::optional<Pose>& odom_from_camera) {
   if (frame.ids.empty()) return {};
-  // The target's corners become fixed landmarks the first time all four are tracked;
-  // the tracker adds them in TargetDetection's order, so ascending ids give the corners.
-  if (target_ids_.empty()) {
-    std::vector<std::uint64_t> corners;
-    for (size_t i = 0; i < frame.ids.size(); ++i)
-      if (frame.target_corner[i]) corners.push_back(frame.ids[i]);
-    if (corners.size() == 4) {
-      std::sort(corners.begin(), corners.end());
-      const auto map_corners = targetCornersInMap(target_);
-      for (int k = 0; k < 4; ++k) {
-        Landmark& l = landmarks_[corners[k]];
-        l.fixed = true;
-        l.position = cv::Vec3d(map_corners[k].x, map_corners[k].y, map_corners[k].z);
-      }
-      target_ids_ = corners;
+  // The target's corners become fixed landmarks whenever all four are tracked under new
+  // ids (the first time, and when the tracker found the target again after a loss); the
+  // tracker adds them in TargetDetection's order, so ascending ids give the corners.
+  std::vector<std::uint64_t> corners;
+  for (size_t i = 0; i < frame.ids.size(); ++i)
+    if (frame.target_corner[i]) corners.push_back(frame.ids[i]);
+  std::sort(corners.begin(), corners.end());
+  if (corners.size() == 4 && corners != target_ids_) {
+    const auto map_corners = targetCornersInMap(target_);
+    for (int k = 0; k < 4; ++k) {
+      Landmark& l = landmarks_[corners[k]];
+      l.fixed = true;
+      l.triangulated = false;
+      l.position = cv::Vec3d(map_corners[k].x, map_corners[k].y, map_corners[k].z);
+      l.last_seen = frame.stamp;
     }
+    target_ids_ = corners;
   }
   if (target_ids_.empty()) return {};  // no metres without the target
 

@@ -2,9 +2,31 @@
 
 #include <sensor_msgs/image_encodings.h>
 
+#include <algorithm>
 #include <sstream>
 
 namespace mono_plane_detection {
+namespace {
+
+// cv_bridge hands big-endian multi-byte images through without swapping (Debian 12's
+// version returned a 16-bit image for a mono8 request): swap them here.
+sensor_msgs::ImageConstPtr littleEndian(const sensor_msgs::ImageConstPtr& msg) {
+  if (!msg->is_bigendian) return msg;
+  int bytes = 1;
+  try {
+    bytes = sensor_msgs::image_encodings::bitDepth(msg->encoding) / 8;
+  } catch (const std::exception&) {
+    return msg;  // unknown encoding: cv_bridge will say so
+  }
+  if (bytes <= 1) return msg;
+  sensor_msgs::ImagePtr copy(new sensor_msgs::Image(*msg));
+  for (size_t i = 0; i + bytes <= copy->data.size(); i += bytes)
+    std::reverse(copy->data.begin() + i, copy->data.begin() + i + bytes);
+  copy->is_bigendian = 0;
+  return copy;
+}
+
+}  // namespace
 
 GreyImage toGrey(const sensor_msgs::ImageConstPtr& msg) {
   GreyImage out;
@@ -23,11 +45,21 @@ GreyImage toGrey(const sensor_msgs::ImageConstPtr& msg) {
     return out;
   }
   try {
-    out.image = cv_bridge::toCvShare(msg, sensor_msgs::image_encodings::MONO8);
+    out.image = cv_bridge::toCvShare(littleEndian(msg), sensor_msgs::image_encodings::MONO8);
   } catch (const cv_bridge::Exception& e) {
     out.error = "unsupported encoding '" + msg->encoding + "': " + e.what();
+    return out;
   } catch (const cv::Exception& e) {
     out.error = "cannot convert encoding '" + msg->encoding + "' to mono8: " + e.what();
+    return out;
+  } catch (const std::exception& e) {
+    out.error = "cannot convert encoding '" + msg->encoding + "': " + e.what();
+    return out;
+  }
+  // Never hand the tracker anything but 8-bit grey, whatever cv_bridge returned.
+  if (!out.image || out.image->image.empty() || out.image->image.type() != CV_8UC1) {
+    out.error = "encoding '" + msg->encoding + "' did not convert to 8-bit grey";
+    out.image.reset();
   }
   return out;
 }

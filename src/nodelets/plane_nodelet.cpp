@@ -229,9 +229,11 @@ class PlaneNodelet : public nodelet::Nodelet {
         if (publish_tf_ && odom)  // map -> odom, so that the robot's tf tree stays a tree
           tf = toTransform(result.pose->map_from_camera * odom->inverse(), msg->header, map_frame_,
                            odom_frame_);
-        else if (publish_tf_)
+        else if (publish_tf_ && !msg->header.frame_id.empty())
           tf = toTransform(result.pose->map_from_camera, msg->header, map_frame_,
                            msg->header.frame_id);
+        else if (publish_tf_)
+          NODELET_WARN_THROTTLE(10.0, "tracks have an empty frame_id: no map -> camera tf");
       }
       if (debug_pub_.getNumSubscribers() > 0) {
         for (const auto& image : images_)

@@ -113,6 +113,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     tracker_ = FeatureTracker(sanitized(readParams(pnh), getName()));
     pnh.param("lazy", lazy_, true);
     pnh.param("detect_target", detect_target_, true);
+    pnh.param("max_gap_s", max_gap_s_, 1.0);
     pnh.param("target_width_m", target_params_.width_m, target_params_.width_m);
     pnh.param("target_height_m", target_params_.height_m, target_params_.height_m);
     target_startup_ = TargetStartup(target_params_);
@@ -190,6 +191,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     std::vector<TrackedPoint> points;
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
+      if (!last_stamp_.isZero() && msg->header.stamp == last_stamp_) {
+        ++dropped_;  // the same image twice (a republisher, a bag with duplicates)
+        NODELET_WARN_THROTTLE(5.0, "dropping image: its stamp %.3f repeats the previous one",
+                              msg->header.stamp.toSec());
+        return;
+      }
       if (!last_stamp_.isZero() && msg->header.stamp < last_stamp_) {
         NODELET_WARN(
             "image stamp %.3f is before the previous one (%.3f): time went "
@@ -197,7 +204,18 @@ class TrackerNodelet : public nodelet::Nodelet {
             msg->header.stamp.toSec(), last_stamp_.toSec());
         tracker_.reset();
         target_startup_.reset();
+      } else if (!last_stamp_.isZero() &&
+                 (msg->header.stamp - last_stamp_).toSec() > max_gap_s_) {
+        // After a pause the scene may have moved anywhere: Lucas-Kanade would follow
+        // the old points into the wrong places.
+        NODELET_WARN_THROTTLE(5.0, "%.1f s without images: tracking lost, starting over",
+                              (msg->header.stamp - last_stamp_).toSec());
+        tracker_.reset();
+        target_startup_.reset();
       }
+      if (msg->header.frame_id.empty())
+        NODELET_WARN_THROTTLE(10.0, "images have an empty frame_id: tf from the plane "
+                                    "nodelet will not name the camera");
       if (grey.image->image.size() != last_size_)
         target_startup_.reset();  // the tracker resets too
       last_size_ = grey.image->image.size();
@@ -257,6 +275,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // tracker and counters
   ros::Time last_stamp_;
+  double max_gap_s_ = 1.0;  // a longer pause between images is a tracking loss
   std::atomic<long> dropped_{0};
   long lost_ = 0;
   long searches_ = 0;
