@@ -15,6 +15,9 @@
 #include <limits>
 #include <map>
 
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
+
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
 #include <opencv2/calib3d.hpp>
@@ -145,6 +148,13 @@ TEST_F(PlaneNodeletTest, B_ZeroIntrinsicsAreRejected) {
   ASSERT_TRUE(last);
   EXPECT_FALSE(last->metric);
   EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
+  sensor_msgs::CameraInfo nan = cameraInfo(world_->camera);
+  nan.K[2] = std::numeric_limits<double>::quiet_NaN();
+  info_pub_.publish(nan);
+  ros::WallDuration(0.5).sleep();
+  const PlaneArrayConstPtr after_nan = drive(3 / 30.0, 3, 100);
+  ASSERT_TRUE(after_nan);
+  EXPECT_EQ(after_nan->status, "no camera intrinsics: image-space planes only");
 }
 
 TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
@@ -359,6 +369,35 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
   EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
   EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0), ros::Duration(2.0)));
+}
+
+// Killing the plane nodelet while tracks keep coming, and loading it again: it answers
+// at once (image-space planes until it has intrinsics and the start) and becomes metric.
+TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
+  nodelet::NodeletUnload unload;
+  unload.request.name = "/plane_detector";
+  ASSERT_TRUE(ros::service::call("/manager/unload_nodelet", unload));
+  ASSERT_TRUE(unload.response.success);
+  // Tracks go on with nobody listening on this instance.
+  for (int k = 0; k < 5; ++k) tracks_pub_.publish(toTracks(world_->frame(k / 30.0)));
+  nodelet::NodeletLoad load;
+  load.request.name = "/plane_detector";
+  load.request.type = "mono_plane_detection/PlaneNodelet";
+  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load));
+  ASSERT_TRUE(load.response.success);
+  info_pub_.publish(cameraInfo(world_->camera));  // latched: the new instance gets it
+  const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(10);
+  while (planes_sub_.getNumPublishers() == 0 && ros::WallTime::now() < ready) {
+    ros::spinOnce();
+    ros::WallDuration(0.05).sleep();
+  }
+  ros::WallDuration(1.0).sleep();
+  const PlaneArrayConstPtr first = drive(0, 1, 800);
+  ASSERT_TRUE(first) << "the reloaded nodelet does not answer";
+  EXPECT_FALSE(first->metric);
+  const PlaneArrayConstPtr later = drive(1 / 30.0, 80, 800);
+  ASSERT_TRUE(later);
+  EXPECT_TRUE(later->metric) << later->status;
 }
 
 }  // namespace
