@@ -35,10 +35,12 @@ TEST(PlaneAccuracy, RenderedSequence) {
   ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 5);
   std::map<uint64_t, PlaneArrayConstPtr> planes;
   ros::Subscriber sub = nh.subscribe<PlaneArray>(
-      "/camera/planes", 50, [&](const PlaneArrayConstPtr& m) { planes[m->header.stamp.toNSec()] = m; });
+      "/camera/planes", 50,
+      [&](const PlaneArrayConstPtr& m) { planes[m->header.stamp.toNSec()] = m; });
   const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(30);
-  while (ros::ok() && (image_pub.getNumSubscribers() == 0 || info_pub.getNumSubscribers() == 0 ||
-                       sub.getNumPublishers() == 0) &&
+  while (ros::ok() &&
+         (image_pub.getNumSubscribers() == 0 || info_pub.getNumSubscribers() == 0 ||
+          sub.getNumPublishers() == 0) &&
          ros::WallTime::now() < ready) {
     ros::spinOnce();
     ros::WallDuration(0.05).sleep();
@@ -71,7 +73,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     last = planes[key];
     if (last->metric)
       if (const auto t = poseAt(truth, image->header.stamp.toSec()))
-        position_errors.push_back(cv::norm(poseOf(last->camera_pose).t - t->t));
+        position_errors.push_back(cv::norm(fromPoseMsg(last->camera_pose).t - t->t));
   }
   ASSERT_EQ(images, spec.frames);
   ASSERT_TRUE(last);

@@ -3,6 +3,8 @@
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -15,14 +17,10 @@
 #include <limits>
 #include <map>
 
-#include <nodelet/NodeletLoad.h>
-#include <nodelet/NodeletUnload.h>
-
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
-#include <opencv2/calib3d.hpp>
-
 #include "mono_plane_detection/plane_fit.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 #include "synthetic_tracks.h"
 
 using namespace mono_plane_detection;
@@ -72,8 +70,9 @@ class PlaneNodeletTest : public ::testing::Test {
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
     // Both nodelets live in one manager process: one connection.
-    while (ros::ok() && (tracks_pub_.getNumSubscribers() == 0 || planes_sub_.getNumPublishers() == 0 ||
-                         no_info_sub_.getNumPublishers() == 0) &&
+    while (ros::ok() &&
+           (tracks_pub_.getNumSubscribers() == 0 || planes_sub_.getNumPublishers() == 0 ||
+            no_info_sub_.getNumPublishers() == 0) &&
            ros::WallTime::now() < deadline) {
       ros::spinOnce();
       ros::WallDuration(0.05).sleep();
@@ -161,7 +160,8 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   info_pub_.publish(cameraInfo(world_->camera));
   ros::WallDuration(0.5).sleep();
   ros::Subscriber markers = nh_.subscribe<visualization_msgs::MarkerArray>(
-      "plane_markers", 10, [this](const visualization_msgs::MarkerArrayConstPtr& m) { markers_ = m; });
+      "plane_markers", 10,
+      [this](const visualization_msgs::MarkerArrayConstPtr& m) { markers_ = m; });
   ros::Subscriber cloud = nh_.subscribe<sensor_msgs::PointCloud2>(
       "map_points", 10, [this](const sensor_msgs::PointCloud2ConstPtr& c) { cloud_ = c; });
   tf2_ros::Buffer buffer;
@@ -325,7 +325,8 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
   std::map<uint64_t, PlaneArrayConstPtr> answers;
   ros::Subscriber sub = nh_.subscribe<PlaneArray>(
-      "planes_odom", 50, [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+      "planes_odom", 50,
+      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
@@ -346,17 +347,7 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
     tf.header.stamp = ros::Time(f.stamp);
     tf.header.frame_id = "odom";
     tf.child_frame_id = "camera_optical";
-    tf.transform.translation.x = odom.t[0];
-    tf.transform.translation.y = odom.t[1];
-    tf.transform.translation.z = odom.t[2];
-    cv::Vec3d r;
-    cv::Rodrigues(odom.R, r);
-    const double angle = cv::norm(r);
-    const cv::Vec3d axis = angle > 1e-12 ? r / angle : cv::Vec3d(1, 0, 0);
-    tf.transform.rotation.w = std::cos(angle / 2);
-    tf.transform.rotation.x = axis[0] * std::sin(angle / 2);
-    tf.transform.rotation.y = axis[1] * std::sin(angle / 2);
-    tf.transform.rotation.z = axis[2] * std::sin(angle / 2);
+    tf.transform = toTransformMsg(odom);
     broadcaster.sendTransform(tf);
     ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
     tracks.publish(toTracks(f));

@@ -14,10 +14,10 @@
 #include <deque>
 #include <memory>
 #include <mutex>
-#include <opencv2/calib3d.hpp>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "mono_plane_detection/draw_planes.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 #include "plane_messages.h"
 #include "plane_params.h"
 
@@ -31,28 +31,8 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child,
   tf.header.stamp = header.stamp;
   tf.header.frame_id = parent;
   tf.child_frame_id = child;
-  tf.transform.translation.x = parent_from_child.t[0];
-  tf.transform.translation.y = parent_from_child.t[1];
-  tf.transform.translation.z = parent_from_child.t[2];
-  cv::Vec3d rvec;
-  cv::Rodrigues(parent_from_child.R, rvec);
-  const double angle = cv::norm(rvec);
-  const cv::Vec3d axis = angle > 1e-12 ? rvec / angle : cv::Vec3d(1, 0, 0);
-  tf.transform.rotation.w = std::cos(angle / 2);
-  tf.transform.rotation.x = axis[0] * std::sin(angle / 2);
-  tf.transform.rotation.y = axis[1] * std::sin(angle / 2);
-  tf.transform.rotation.z = axis[2] * std::sin(angle / 2);
+  tf.transform = toTransformMsg(parent_from_child);
   return tf;
-}
-
-Pose fromTransform(const geometry_msgs::Transform& t) {
-  const double w = t.rotation.w, x = t.rotation.x, y = t.rotation.y, z = t.rotation.z;
-  Pose p;
-  p.R = cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
-                    2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-                    2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
-  p.t = cv::Vec3d(t.translation.x, t.translation.y, t.translation.z);
-  return p;
 }
 
 }  // namespace
@@ -151,7 +131,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     try {
       // Never wait in a callback: take what tf has for this stamp or go visual.
       const auto tf = tf_buffer_->lookupTransform(odom_frame_, header.frame_id, header.stamp);
-      return fromTransform(tf.transform);
+      return fromTransformMsg(tf.transform);
     } catch (const tf2::TransformException& e) {
       NODELET_WARN_THROTTLE(10.0, "no %s -> %s transform at %.3f (%s): visual pose only",
                             odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
@@ -204,14 +184,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       status_ = result.status;
       observed_ = result.planes.size();
       planes = toPlaneArray(msg->header, map_frame_, result, pipeline_->map());
-      if (planes->metric) {
-        const geometry_msgs::TransformStamped pose =
-            toTransform(result.pose->map_from_camera, msg->header, map_frame_, "");
-        planes->camera_pose.position.x = pose.transform.translation.x;
-        planes->camera_pose.position.y = pose.transform.translation.y;
-        planes->camera_pose.position.z = pose.transform.translation.z;
-        planes->camera_pose.orientation = pose.transform.rotation;
-      }
+      if (planes->metric) planes->camera_pose = toPoseMsg(result.pose->map_from_camera);
       if (planes->metric) {
         std_msgs::Header map_header = msg->header;
         map_header.frame_id = map_frame_;

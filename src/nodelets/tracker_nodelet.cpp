@@ -204,8 +204,7 @@ class TrackerNodelet : public nodelet::Nodelet {
             msg->header.stamp.toSec(), last_stamp_.toSec());
         tracker_.reset();
         target_startup_.reset();
-      } else if (!last_stamp_.isZero() &&
-                 (msg->header.stamp - last_stamp_).toSec() > max_gap_s_) {
+      } else if (!last_stamp_.isZero() && (msg->header.stamp - last_stamp_).toSec() > max_gap_s_) {
         // After a pause the scene may have moved anywhere: Lucas-Kanade would follow
         // the old points into the wrong places.
         NODELET_WARN_THROTTLE(5.0, "%.1f s without images: tracking lost, starting over",
@@ -214,8 +213,9 @@ class TrackerNodelet : public nodelet::Nodelet {
         target_startup_.reset();
       }
       if (msg->header.frame_id.empty())
-        NODELET_WARN_THROTTLE(10.0, "images have an empty frame_id: tf from the plane "
-                                    "nodelet will not name the camera");
+        NODELET_WARN_THROTTLE(10.0,
+                              "images have an empty frame_id: tf from the plane "
+                              "nodelet will not name the camera");
       if (grey.image->image.size() != last_size_)
         target_startup_.reset();  // the tracker resets too
       last_size_ = grey.image->image.size();

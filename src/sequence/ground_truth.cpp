@@ -14,17 +14,6 @@ cv::Vec3d vec3(const YAML::Node& n) {
 
 }  // namespace
 
-Pose poseOf(const geometry_msgs::Pose& pose) {
-  const double w = pose.orientation.w, x = pose.orientation.x, y = pose.orientation.y,
-               z = pose.orientation.z;
-  Pose p;
-  p.R = cv::Matx33d(1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
-                    2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-                    2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y));
-  p.t = cv::Vec3d(pose.position.x, pose.position.y, pose.position.z);
-  return p;
-}
-
 GroundTruth loadGroundTruth(const std::string& yaml_path) {
   GroundTruth truth;
   try {
@@ -52,7 +41,7 @@ GroundTruth loadGroundTruth(const std::string& yaml_path) {
       pose.orientation.w = e["orientation_xyzw"][3].as<double>();
       if (!truth.poses.empty()) truth.travelled_m += cv::norm(t - truth.poses.back().t);
       truth.stamps.push_back(e["stamp"].as<double>());
-      truth.poses.push_back(poseOf(pose));
+      truth.poses.push_back(fromPoseMsg(pose));
     }
   } catch (const YAML::Exception& e) {
     throw std::runtime_error("cannot read ground truth " + yaml_path + ": " + e.what());

@@ -9,6 +9,7 @@
 
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/map_evaluation.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 
 namespace mono_plane_detection {
 
@@ -30,7 +31,5 @@ std::optional<Pose> poseAt(const GroundTruth& truth, double stamp);
 // The metric planes of a PlaneArray as map planes (id, normal, distance, polygon,
 // observations, confidence); confirmed_only drops those seen fewer than `confirm` times.
 std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm = 3);
-
-Pose poseOf(const geometry_msgs::Pose& pose);
 
 }  // namespace mono_plane_detection

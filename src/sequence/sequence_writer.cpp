@@ -14,29 +14,10 @@
 #include <stdexcept>
 
 #include "mono_plane_detection/map_evaluation.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 
 namespace mono_plane_detection {
 namespace {
-
-// Quaternion (x, y, z, w) of a rotation matrix.
-cv::Vec4d quaternion(const cv::Matx33d& R) {
-  cv::Vec4d q;
-  const double trace = R(0, 0) + R(1, 1) + R(2, 2);
-  if (trace > 0) {
-    const double s = 0.5 / std::sqrt(trace + 1.0);
-    q = {(R(2, 1) - R(1, 2)) * s, (R(0, 2) - R(2, 0)) * s, (R(1, 0) - R(0, 1)) * s, 0.25 / s};
-  } else if (R(0, 0) > R(1, 1) && R(0, 0) > R(2, 2)) {
-    const double s = 2.0 * std::sqrt(1.0 + R(0, 0) - R(1, 1) - R(2, 2));
-    q = {0.25 * s, (R(0, 1) + R(1, 0)) / s, (R(0, 2) + R(2, 0)) / s, (R(2, 1) - R(1, 2)) / s};
-  } else if (R(1, 1) > R(2, 2)) {
-    const double s = 2.0 * std::sqrt(1.0 + R(1, 1) - R(0, 0) - R(2, 2));
-    q = {(R(0, 1) + R(1, 0)) / s, 0.25 * s, (R(1, 2) + R(2, 1)) / s, (R(0, 2) - R(2, 0)) / s};
-  } else {
-    const double s = 2.0 * std::sqrt(1.0 + R(2, 2) - R(0, 0) - R(1, 1));
-    q = {(R(0, 2) + R(2, 0)) / s, (R(1, 2) + R(2, 1)) / s, 0.25 * s, (R(1, 0) - R(0, 1)) / s};
-  }
-  return q / cv::norm(q);
-}
 
 YAML::Node vec(const cv::Vec3d& v) {
   YAML::Node n;
@@ -128,9 +109,9 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
     YAML::Node entry;
     entry["stamp"] = spec.start_time_s + k / spec.fps;
     entry["position"] = vec(pose.t);
-    const cv::Vec4d q = quaternion(pose.R);
+    const geometry_msgs::Quaternion q = toQuaternionMsg(pose.R);
     entry["orientation_xyzw"].SetStyle(YAML::EmitterStyle::Flow);
-    for (int i = 0; i < 4; ++i) entry["orientation_xyzw"].push_back(q[i]);
+    for (double c : {q.x, q.y, q.z, q.w}) entry["orientation_xyzw"].push_back(c);
     root["camera_gt_in_map"].push_back(entry);
   }
   std::ofstream out(path);
@@ -189,14 +170,7 @@ SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_pa
     tf.header.stamp = header.stamp;
     tf.header.frame_id = spec.map_frame;
     tf.child_frame_id = spec.ground_truth_frame;
-    tf.transform.translation.x = gt.t[0];
-    tf.transform.translation.y = gt.t[1];
-    tf.transform.translation.z = gt.t[2];
-    const cv::Vec4d q = quaternion(gt.R);
-    tf.transform.rotation.x = q[0];
-    tf.transform.rotation.y = q[1];
-    tf.transform.rotation.z = q[2];
-    tf.transform.rotation.w = q[3];
+    tf.transform = toTransformMsg(gt);
     tf2_msgs::TFMessage tf_msg;
     tf_msg.transforms.push_back(tf);
     bag.write("/tf", header.stamp, tf_msg);

@@ -34,8 +34,8 @@ int main(int argc, char** argv) {
   ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 5);
   std::mutex mutex;
   std::map<ros::Time, double> plane_latency_ms, tracks_latency_ms;
-  ros::Subscriber planes = nh.subscribe<PlaneArray>(
-      "/camera/planes", 50, [&](const PlaneArrayConstPtr& m) {
+  ros::Subscriber planes =
+      nh.subscribe<PlaneArray>("/camera/planes", 50, [&](const PlaneArrayConstPtr& m) {
         std::lock_guard<std::mutex> lock(mutex);
         plane_latency_ms[m->header.stamp] = (ros::Time::now() - m->header.stamp).toSec() * 1e3;
       });
@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   ros::WallDuration(1.0).sleep();
 
   rosbag::Bag bag(bag_path);
-  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/camera/image_raw", "/camera/camera_info"}));
+  rosbag::View view(bag, rosbag::TopicQuery(
+                             std::vector<std::string>{"/camera/image_raw", "/camera/camera_info"}));
   ros::WallRate pace(rate);
   int sent = 0;
   for (const rosbag::MessageInstance& m : view) {
@@ -82,8 +83,8 @@ int main(int argc, char** argv) {
     double mean = 0;
     for (double x : v) mean += x / v.size();
     std::printf("%-28s %4zu of %d images: mean %.1f ms, p50 %.1f, p95 %.1f, max %.1f\n", what,
-                v.size(), sent, mean, v[v.size() / 2], v[std::min(v.size() - 1, v.size() * 95 / 100)],
-                v.back());
+                v.size(), sent, mean, v[v.size() / 2],
+                v[std::min(v.size() - 1, v.size() * 95 / 100)], v.back());
   };
   std::lock_guard<std::mutex> lock(mutex);
   std::printf("End-to-end latency at %.0f images/s (image stamp -> message received):\n", rate);

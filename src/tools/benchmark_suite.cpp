@@ -48,9 +48,8 @@ std::vector<cv::Mat> frames(const cv::Size& size, int count) {
   cv::RNG rng(7);
   for (int k = 0; k < count; ++k) {
     const cv::Point2d shift(-size.width / 2.0 + 1.5 * k, -size.height / 2.0 + 0.5 * k);
-    cv::Mat view = warpView(texture, similarity(0.002 * k, {size.width / 2.0, size.height / 2.0},
-                                                shift),
-                            size);
+    cv::Mat view = warpView(
+        texture, similarity(0.002 * k, {size.width / 2.0, size.height / 2.0}, shift), size);
     cv::Mat noise(view.size(), CV_16SC1);
     rng.fill(noise, cv::RNG::NORMAL, 0, 3);
     cv::Mat noisy;
@@ -92,8 +91,7 @@ std::vector<double> timeBaselineTracker(const std::vector<cv::Mat>& images, int 
       std::vector<uchar> status;
       std::vector<float> error;
       cv::calcOpticalFlowPyrLK(previous, images[k], points, next, status, error,
-                               cv::Size(p.window_size_px, p.window_size_px),
-                               p.pyramid_levels - 1);
+                               cv::Size(p.window_size_px, p.window_size_px), p.pyramid_levels - 1);
       points.clear();
       for (size_t i = 0; i < next.size(); ++i)
         if (status[i]) points.push_back(next[i]);
@@ -123,8 +121,8 @@ std::vector<int> sequentialMagsac(const std::vector<cv::Point2d>& a,
     if (H.empty() || cv::countNonZero(mask) < min_support) break;
     std::vector<int> rest;
     for (size_t k = 0; k < remaining.size(); ++k)
-      (mask.at<uchar>(static_cast<int>(k)) ? labels[remaining[k]] = plane, void()
-                                            : rest.push_back(remaining[k]));
+      (mask.at<uchar>(static_cast<int>(k)) ? labels[remaining[k]] = plane,
+       void()                              : rest.push_back(remaining[k]));
     remaining.swap(rest);
   }
   return labels;
@@ -227,20 +225,25 @@ int main(int argc, char** argv) {
   int count = 100, repeats = 20;
   std::string plot_path = "benchmark.png";
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) count = std::max(20, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--plot") && i + 1 < argc) plot_path = argv[++i];
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
+      count = std::max(20, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
+      repeats = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--plot") && i + 1 < argc)
+      plot_path = argv[++i];
     else {
       std::printf("usage: benchmark_suite [--frames N] [--repeats N] [--plot file.png]\n");
       return std::strcmp(argv[i], "--help") ? 2 : 0;
     }
   }
   cv::setNumThreads(1);
-  std::printf("benchmark_suite: one thread; %d generated frames per tracker row, %d scenes per "
-              "plane row.\n\n",
-              count, repeats);
-  std::printf("Tracker (ours) against goodFeaturesToTrack + calcOpticalFlowPyrLK (baseline),\n"
-              "ms per frame, mean / p95:\n");
+  std::printf(
+      "benchmark_suite: one thread; %d generated frames per tracker row, %d scenes per "
+      "plane row.\n\n",
+      count, repeats);
+  std::printf(
+      "Tracker (ours) against goodFeaturesToTrack + calcOpticalFlowPyrLK (baseline),\n"
+      "ms per frame, mean / p95:\n");
   std::printf("  %-10s %6s %16s %16s %8s\n", "image", "feat.", "ours", "baseline", "ratio");
   std::vector<std::pair<int, std::pair<double, double>>> tracker_vga;
   for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480), cv::Size(1280, 720)}) {
@@ -253,11 +256,12 @@ int main(int argc, char** argv) {
       if (size.width == 640) tracker_vga.push_back({features, {ours.mean, base.mean}});
     }
   }
-  std::printf("\nPlane stage (segmentPlanes) against sequential MAGSAC (cv::findHomography\n"
-              "USAC_MAGSAC, remove inliers, repeat), 3 planes, 20 %% outliers, 0.7 px noise,\n"
-              "threshold 2.8 px. ms per frame mean / p95, misclassification error:\n");
-  std::printf("  %6s %16s %16s %8s %9s %9s\n", "points", "ours", "baseline", "ratio",
-              "ours err", "base err");
+  std::printf(
+      "\nPlane stage (segmentPlanes) against sequential MAGSAC (cv::findHomography\n"
+      "USAC_MAGSAC, remove inliers, repeat), 3 planes, 20 %% outliers, 0.7 px noise,\n"
+      "threshold 2.8 px. ms per frame mean / p95, misclassification error:\n");
+  std::printf("  %6s %16s %16s %8s %9s %9s\n", "points", "ours", "baseline", "ratio", "ours err",
+              "base err");
   std::vector<PlaneRow> rows;
   for (int points : {50, 200, 500, 1000}) {
     const PlaneRow r = benchPlanes(points, repeats);

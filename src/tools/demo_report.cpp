@@ -160,7 +160,7 @@ class Report {
       overlay_ = {images_[msg->header.stamp], tracks_[msg->header.stamp], msg};
     if (truth_ && msg->metric)
       if (const auto truth = poseAt(*truth_, msg->header.stamp.toSec()))
-        position_errors_.push_back(cv::norm(poseOf(msg->camera_pose).t - truth->t));
+        position_errors_.push_back(cv::norm(fromPoseMsg(msg->camera_pose).t - truth->t));
     if (expected_ > 0 && (planes_seen_ % 30 == 0 || planes_seen_ == expected_)) {
       std::printf("  frames %d / %d: %s, %zu planes\n", planes_seen_, expected_,
                   msg->status.c_str(), msg->planes.size());
@@ -249,7 +249,7 @@ class Report {
  public:
   void recordPath() {
     if (last_planes_ && last_planes_->metric && last_planes_.get() != last_recorded_) {
-      path_.push_back(poseOf(last_planes_->camera_pose).t);
+      path_.push_back(fromPoseMsg(last_planes_->camera_pose).t);
       last_recorded_ = last_planes_.get();
     }
   }
