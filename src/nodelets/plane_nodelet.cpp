@@ -1,8 +1,6 @@
 // Thin ROS glue around PlanePipeline: tracks (+ camera_info, optional odometry tf) in;
 // planes, rviz markers, the map's points, map -> camera tf and a debug image out.
 #include <cv_bridge/cv_bridge.h>
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <diagnostic_updater/update_functions.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
@@ -18,6 +16,7 @@
 
 #include "mono_plane_detection/draw_planes.h"
 #include "mono_plane_detection/ros/pose_msg.h"
+#include "nodelet_diagnostics.h"
 #include "plane_messages.h"
 #include "plane_params.h"
 
@@ -39,10 +38,6 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child,
 
 class PlaneNodelet : public nodelet::Nodelet {
  public:
-  ~PlaneNodelet() override {
-    if (updater_) updater_->broadcast(diagnostic_msgs::DiagnosticStatus::OK, "shutting down");
-  }
-
  private:
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
@@ -68,16 +63,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
 
-    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
-    updater_->setHardwareID("camera");
-    rate_diagnostic_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
-        diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
-    pnh.param("expected_min_rate_hz", min_rate_, 5.0);
-    pnh.param("expected_max_rate_hz", max_rate_, 100.0);
-    updater_->add(*rate_diagnostic_);
-    updater_->add("planes", this, &PlaneNodelet::diagnose);
-    diagnostic_timer_ =
-        nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
+    diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose);
 
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens).
@@ -219,7 +205,7 @@ class PlaneNodelet : public nodelet::Nodelet {
           }
       }
     }
-    rate_diagnostic_->tick();
+    diagnostics_.tick();
     planes->processing_ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
     planes_pub_.publish(planes);  // shared pointers: no copy inside one manager
     if (markers) markers_pub_.publish(markers);
@@ -257,10 +243,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  ros::Timer diagnostic_timer_, no_info_timer_;
-  std::unique_ptr<diagnostic_updater::Updater> updater_;
-  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_diagnostic_;
-  double min_rate_ = 5.0, max_rate_ = 100.0;
+  ros::Timer no_info_timer_;
+  NodeletDiagnostics diagnostics_;
 
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;

@@ -1,6 +1,4 @@
 // Thin ROS glue around FeatureTracker: image in, Tracks and a debug image out.
-#include <diagnostic_updater/diagnostic_updater.h>
-#include <diagnostic_updater/update_functions.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
@@ -17,6 +15,7 @@
 #include "mono_plane_detection/draw_tracks.h"
 #include "mono_plane_detection/feature_tracker.h"
 #include "mono_plane_detection/target_startup.h"
+#include "nodelet_diagnostics.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -119,16 +118,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     target_startup_ = TargetStartup(target_params_);
     pnh.param<std::string>("image_transport", transport_, "raw");
 
-    updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, getName());
-    updater_->setHardwareID("camera");
-    rate_diagnostic_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
-        diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
-    pnh.param("expected_min_rate_hz", min_rate_, 5.0);
-    pnh.param("expected_max_rate_hz", max_rate_, 100.0);
-    updater_->add(*rate_diagnostic_);
-    updater_->add("tracking", this, &TrackerNodelet::diagnose);
-    diagnostic_timer_ =
-        nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
+    diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose);
 
     it_ = std::make_unique<image_transport::ImageTransport>(nh);
     std::lock_guard<std::mutex> lock(connect_mutex_);
@@ -179,7 +169,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   }
 
   void imageCallback(const sensor_msgs::ImageConstPtr& msg) {
-    rate_diagnostic_->tick();
+    diagnostics_.tick();
     const ros::WallTime started = ros::WallTime::now();
     const GreyImage grey = toGrey(msg);
     if (!grey.image) {
@@ -286,10 +276,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   TargetStartup target_startup_;
   cv::Size last_size_;
 
-  double min_rate_ = 5.0, max_rate_ = 100.0;
-  std::unique_ptr<diagnostic_updater::Updater> updater_;
-  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_diagnostic_;
-  ros::Timer diagnostic_timer_;
+  NodeletDiagnostics diagnostics_;
 };
 
 }  // namespace mono_plane_detection

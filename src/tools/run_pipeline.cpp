@@ -143,18 +143,17 @@ int main(int argc, char** argv) {
       }
       const cv::Mat image = renderer.render(world_from_camera, seed * 100000u + k);
       const auto t0 = Clock::now();
-      const auto& points = tracker.process(image);
+      tracker.process(image);
       startup.process(image, tracker);
       const auto t1 = Clock::now();
       TrackFrame frame;
-      frame.stamp = 1000.0 + loop * 0.0 + t;  // every loop starts over in time: a bag loop
+      frame.stamp = 1000.0 + t;  // every loop starts over in time: a bag loop
       frame.size = image.size();
       for (const TrackedPoint& p : tracker.current()) {
         frame.ids.push_back(p.id);
         frame.pixels.emplace_back(p.uv.x, p.uv.y);
         frame.target_corner.push_back(p.is_target_corner);
       }
-      (void)points;
       const PipelineResult result = pipeline.process(frame);
       const auto t2 = Clock::now();
       track_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
