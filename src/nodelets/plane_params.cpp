@@ -1,5 +1,7 @@
 #include "plane_params.h"
 
+#include "param_check.h"
+
 namespace mono_plane_detection {
 namespace {
 
@@ -49,12 +51,7 @@ PipelineParams readPipelineParams(const ros::NodeHandle& pnh, const std::string&
   paramSize(pnh, "max_points_per_plane", p.map.max_points_per_plane);
 
   const PipelineParams d;
-  auto fix = [&](bool bad, const char* what, auto& value, auto fallback) {
-    if (!bad) return;
-    ROS_ERROR_STREAM_NAMED(
-        logger, "parameter " << what << " = " << value << " is invalid; using " << fallback);
-    value = fallback;
-  };
+  const ParamCheck fix(logger);
   fix(p.frame_gap < 1, "frame_gap", p.frame_gap, d.frame_gap);
   fix(!(p.max_gap_s > 0), "max_gap_s", p.max_gap_s, d.max_gap_s);
   fix(!(p.planes.vote_threshold_px > 0), "vote_threshold_px", p.planes.vote_threshold_px,

@@ -16,6 +16,7 @@
 #include "mono_plane_detection/feature_tracker.h"
 #include "mono_plane_detection/target_startup.h"
 #include "nodelet_diagnostics.h"
+#include "param_check.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -51,12 +52,7 @@ TrackerParams readParams(const ros::NodeHandle& pnh) {
 // Values that would make OpenCV assert are replaced by the defaults, loudly.
 TrackerParams sanitized(TrackerParams p, const std::string& name) {
   const TrackerParams d;
-  auto fix = [&](bool bad, const char* what, auto& value, auto fallback) {
-    if (!bad) return;
-    ROS_ERROR_STREAM_NAMED(
-        name, "parameter " << what << " = " << value << " is invalid; using " << fallback);
-    value = fallback;
-  };
+  const ParamCheck fix(name);
   fix(p.max_features < 1, "max_features", p.max_features, d.max_features);
   fix(p.quality_level <= 0 || p.quality_level >= 1, "quality_level", p.quality_level,
       d.quality_level);
