@@ -6,7 +6,7 @@
 #   make bench   the benchmark suite and end-to-end latency (figures, never pass/fail)
 #   make eval    segment_planes on the AdelaideRMF dev scenes (DATA=folder)
 #   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
-#   make tsan    the nodelets under ThreadSanitizer in a multi-threaded manager
+#   make helgrind  data-race check: the nodelets' rostests under helgrind
 #   make fuzz    libFuzzer targets of test/fuzz, FUZZ_SECONDS each (default 60)
 #   make clean   remove build/
 
@@ -21,7 +21,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build demo test bench eval sanitize tsan fuzz clean
+.PHONY: deps link build demo test bench eval sanitize helgrind fuzz clean
 
 deps:
 	@scripts/install_deps.sh
@@ -51,31 +51,28 @@ demo: build
 	@source $(DEVEL) && scripts/demo.sh $(RESULTS) $(PROFILE) $(FRAMES) \
 	  $(if $(filter 1,$(RVIZ)),true,false) $(if $(BAG),$(abspath $(BAG))) $(if $(TRUTH),$(abspath $(TRUTH)))
 
-# The nodelets built with ThreadSanitizer and run by their rostests under a
-# multi-threaded manager (the manager binary gets the TSan runtime preloaded). Prints a
-# summary of the reports (kept in build/ws_tsan/reports). A diagnostic, not a gate:
-# Debian's ROS is not instrumented, see README "Robustness".
-TSAN_WS := $(REPO)/build/ws_tsan
-TSAN_FLAGS := -fsanitize=thread -fno-omit-frame-pointer
-tsan: deps
-	@scripts/install_deps.sh llvm
-	@mkdir -p $(TSAN_WS)/src $(TSAN_WS)/reports
-	@[ -e $(TSAN_WS)/src/mono_plane_detection ] || ln -sfn $(PKG) $(TSAN_WS)/src/mono_plane_detection
+# The data-race check: both nodelet rostests with their manager (4 worker threads, three
+# plane nodelets) under valgrind's helgrind, which sees every access and lock of the
+# whole process, Debian's uninstrumented ROS included. Fails when a racing access is
+# made by our code (scripts/helgrind_summary.py sorts the rest); XML reports in
+# build/ws_helgrind/reports. About 5 minutes.
+HG_WS := $(REPO)/build/ws_helgrind
+HG_SCALE ?= 20
+helgrind: deps
+	@scripts/install_deps.sh valgrind
+	@mkdir -p $(HG_WS)/src $(HG_WS)/reports
+	@[ -e $(HG_WS)/src/mono_plane_detection ] || ln -sfn $(PKG) $(HG_WS)/src/mono_plane_detection
 	@$(MAKE) --no-print-directory link
-	@cd $(TSAN_WS) && { catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_FLAGS="$(TSAN_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(TSAN_FLAGS)" \
-	  -DCMAKE_SHARED_LINKER_FLAGS="$(TSAN_FLAGS)" && catkin_make -j$(JOBS) tests; } \
-	  > $(TSAN_WS)/build.log 2>&1 || { tail -30 $(TSAN_WS)/build.log; exit 1; }
-	@rm -f $(TSAN_WS)/reports/*
-	@source $(TSAN_WS)/devel/setup.bash && tsan=$$(gcc -print-file-name=libtsan.so) && \
-	  symbolizer=$$(ls /usr/bin/llvm-symbolizer* /usr/lib/llvm-*/bin/llvm-symbolizer 2>/dev/null | head -1) && \
-	  export TSAN_OPTIONS="log_path=$(TSAN_WS)/reports/tsan second_deadlock_stack=1 suppressions=$(REPO)/test/tsan.supp $${symbolizer:+external_symbolizer_path=$$symbolizer}" && \
-	  for t in tracker_nodelet plane_nodelet; do \
-	    rostest mono_plane_detection $$t.test manager_prefix:="env LD_PRELOAD=$$tsan" \
-	      > $(TSAN_WS)/$$t.log 2>&1 && echo "tsan: $$t rostest passed" \
-	      || { echo "tsan: $$t rostest FAILED"; tail -20 $(TSAN_WS)/$$t.log; }; \
-	  done; \
-	  scripts/tsan_summary.py $(TSAN_WS)/reports
+	@cd $(HG_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  mono_plane_detection_nodelets test_plane_nodelet test_tracker_nodelet \
+	  > $(HG_WS)/build.log 2>&1 || { tail -30 $(HG_WS)/build.log; exit 1; }
+	@rm -f $(HG_WS)/reports/*
+	@source $(HG_WS)/devel/setup.bash && failed=0 && for t in tracker_nodelet plane_nodelet; do \
+	  rostest mono_plane_detection $$t.test time_limit:=1800 timeout_scale:=$(HG_SCALE) load_args:=--no-bond \
+	    manager_prefix:="valgrind --tool=helgrind --error-limit=no --num-callers=40 --xml=yes --xml-file=$(HG_WS)/reports/$$t.%p.xml" \
+	    > $(HG_WS)/$$t.log 2>&1 && echo "helgrind: $$t rostest passed" \
+	    || { failed=1; echo "helgrind: $$t rostest FAILED"; tail -20 $(HG_WS)/$$t.log; }; \
+	done; scripts/helgrind_summary.py $(HG_WS)/reports/*.xml && exit $$failed
 
 fuzz: deps
 	@scripts/install_deps.sh clang pkg-config

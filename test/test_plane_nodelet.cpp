@@ -22,6 +22,7 @@
 #include "mono_plane_detection/plane_fit.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "synthetic_tracks.h"
+#include "test_timeouts.h"
 
 using namespace mono_plane_detection;
 
@@ -68,7 +69,7 @@ class PlaneNodeletTest : public ::testing::Test {
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 20);
     planes_sub_ = nh_.subscribe("planes", 50, &PlaneNodeletTest::onPlanes, this);
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
+    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(20.0);
     // Both nodelets live in one manager process: one connection.
     while (ros::ok() &&
            (tracks_pub_.getNumSubscribers() == 0 || planes_sub_.getNumPublishers() == 0 ||
@@ -85,7 +86,7 @@ class PlaneNodeletTest : public ::testing::Test {
 
   template <typename T>
   T waitFor(const std::map<uint64_t, T>& store, uint64_t key, double timeout = 10.0) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(timeout);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       ros::spinOnce();
       const auto it = store.find(key);
@@ -142,7 +143,7 @@ TEST_F(PlaneNodeletTest, B_ZeroIntrinsicsAreRejected) {
   sensor_msgs::CameraInfo zero = cameraInfo(world_->camera);
   zero.K.fill(0.0);
   info_pub_.publish(zero);
-  ros::WallDuration(0.5).sleep();
+  scaledWait(0.5).sleep();
   const PlaneArrayConstPtr last = drive(0, 3, 100);  // 100 s later: a pause, not a problem
   ASSERT_TRUE(last);
   EXPECT_FALSE(last->metric);
@@ -150,7 +151,7 @@ TEST_F(PlaneNodeletTest, B_ZeroIntrinsicsAreRejected) {
   sensor_msgs::CameraInfo nan = cameraInfo(world_->camera);
   nan.K[2] = std::numeric_limits<double>::quiet_NaN();
   info_pub_.publish(nan);
-  ros::WallDuration(0.5).sleep();
+  scaledWait(0.5).sleep();
   const PlaneArrayConstPtr after_nan = drive(3 / 30.0, 3, 100);
   ASSERT_TRUE(after_nan);
   EXPECT_EQ(after_nan->status, "no camera intrinsics: image-space planes only");
@@ -158,7 +159,7 @@ TEST_F(PlaneNodeletTest, B_ZeroIntrinsicsAreRejected) {
 
 TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   info_pub_.publish(cameraInfo(world_->camera));
-  ros::WallDuration(0.5).sleep();
+  scaledWait(0.5).sleep();
   ros::Subscriber markers = nh_.subscribe<visualization_msgs::MarkerArray>(
       "plane_markers", 10,
       [this](const visualization_msgs::MarkerArrayConstPtr& m) { markers_ = m; });
@@ -193,7 +194,7 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
   EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
   // Markers, map points and tf were published.
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(3.0);
+  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(3.0);
   while ((!markers_ || !cloud_) && ros::WallTime::now() < deadline) {
     drive(240 / 30.0, 1, 200);
     ros::spinOnce();
@@ -205,7 +206,8 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   for (const auto& m : markers_->markers)
     polygons += m.ns == "planes" && m.action == visualization_msgs::Marker::ADD;
   EXPECT_GE(polygons, 2);
-  EXPECT_TRUE(buffer.canTransform("map", "camera_optical", ros::Time(0), ros::Duration(2.0)));
+  EXPECT_TRUE(buffer.canTransform("map", "camera_optical", ros::Time(0),
+                                  ros::Duration(2.0 * timeoutScale())));
 }
 
 TEST_F(PlaneNodeletTest, D_BadTracksAreDroppedAndTheMapSurvives) {
@@ -285,7 +287,7 @@ TEST_F(PlaneNodeletTest, G_DebugImageWhileWatched) {
   sensor_msgs::ImageConstPtr drawn;
   ros::Subscriber debug = nh_.subscribe<sensor_msgs::Image>(
       "debug_image", 2, [&](const sensor_msgs::ImageConstPtr& m) { drawn = m; });
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(10.0);
+  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(10.0);
   while (image_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) {
     ros::spinOnce();
     ros::WallDuration(0.05).sleep();
@@ -330,7 +332,7 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(10);
+  const ros::WallTime ready = ros::WallTime::now() + scaledWait(10);
   while (tracks.getNumSubscribers() == 0 && ros::WallTime::now() < ready) {
     ros::spinOnce();
     ros::WallDuration(0.05).sleep();
@@ -359,7 +361,8 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
   EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
   EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
-  EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0), ros::Duration(2.0)));
+  EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0),
+                                  ros::Duration(2.0 * timeoutScale())));
 }
 
 // Killing the plane nodelet while tracks keep coming, and loading it again: it answers
@@ -377,12 +380,12 @@ TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
   ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load));
   ASSERT_TRUE(load.response.success);
   info_pub_.publish(cameraInfo(world_->camera));  // latched: the new instance gets it
-  const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(10);
+  const ros::WallTime ready = ros::WallTime::now() + scaledWait(10);
   while (planes_sub_.getNumPublishers() == 0 && ros::WallTime::now() < ready) {
     ros::spinOnce();
     ros::WallDuration(0.05).sleep();
   }
-  ros::WallDuration(1.0).sleep();
+  scaledWait(1.0).sleep();
   const PlaneArrayConstPtr first = drive(0, 1, 800);
   ASSERT_TRUE(first) << "the reloaded nodelet does not answer";
   EXPECT_FALSE(first->metric);
@@ -397,5 +400,6 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_plane_nodelet");
   ros::NodeHandle nh;
+  readTimeoutScale();
   return RUN_ALL_TESTS();
 }

@@ -12,6 +12,7 @@
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/scene_renderer.h"
 #include "mono_plane_detection/synthetic_views.h"
+#include "test_timeouts.h"
 
 using namespace mono_plane_detection;
 
@@ -26,7 +27,7 @@ class TrackerNodeletTest : public ::testing::Test {
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 10);
     tracks_sub_ = nh_.subscribe("tracks", 50, &TrackerNodeletTest::onTracks, this);
     // The nodelet subscribes lazily: wait until our listener made it subscribe.
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
+    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(20.0);
     while (ros::ok() && image_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) {
       ros::spinOnce();
       ros::WallDuration(0.05).sleep();
@@ -47,7 +48,7 @@ class TrackerNodeletTest : public ::testing::Test {
   TracksConstPtr send(const sensor_msgs::ImagePtr& msg, double timeout = 5.0) {
     image_pub_.publish(msg);
     const auto key = msg->header.stamp.toNSec();
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(timeout);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       ros::spinOnce();
       auto it = received_.find(key);
@@ -264,7 +265,7 @@ TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
   zero.width = 640;
   zero.height = 480;
   info_pub.publish(zero);
-  ros::WallDuration(0.3).sleep();
+  scaledWait(0.3).sleep();
   auto tracks = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
   ASSERT_TRUE(tracks);
   EXPECT_EQ(tracks->id.size(), 50u);
@@ -277,7 +278,7 @@ TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
   info_pub.publish(other_size);
   other_size.K[2] = 640;
   info_pub.publish(other_size);
-  ros::WallDuration(0.3).sleep();
+  scaledWait(0.3).sleep();
   tracks = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
   ASSERT_TRUE(tracks);
   EXPECT_GE(tracks->id.size(), 45u);
@@ -287,16 +288,16 @@ TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
   sensor_msgs::ImageConstPtr debug;
   ros::Subscriber sub = nh_.subscribe<sensor_msgs::Image>(
       "debug_image", 5, [&](const sensor_msgs::ImageConstPtr& m) { debug = m; });
-  const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+  const ros::WallTime connect_deadline = ros::WallTime::now() + scaledWait(5.0);
   while (sub.getNumPublishers() == 0 && ros::WallTime::now() < connect_deadline) {
     ros::spinOnce();
     ros::WallDuration(0.02).sleep();
   }
   ASSERT_GT(sub.getNumPublishers(), 0u);
-  ros::WallDuration(0.3).sleep();  // let the nodelet see its new subscriber
+  scaledWait(0.3).sleep();  // let the nodelet see its new subscriber
   const double stamp = stamp_ += 0.1;
   ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp)));
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(5.0);
   while (!debug && ros::WallTime::now() < deadline) {
     ros::spinOnce();
     ros::WallDuration(0.01).sleep();
@@ -347,5 +348,6 @@ int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "test_tracker_nodelet");
   ros::NodeHandle nh;
+  readTimeoutScale();
   return RUN_ALL_TESTS();
 }
