@@ -84,11 +84,10 @@ test: build
 	@scripts/summarize_tests.sh $(WS)/build/test_results
 
 # The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
-# through the nodelet manager. BENCH_ALL=1 adds the older per-switch tables.
+# through the nodelet manager. BENCH_ALL=1 adds the tracker's per-switch tables.
 bench: build
 	@source $(DEVEL) && scripts/benchmark.sh $(RESULTS)
-	@[ "$(BENCH_ALL)" != 1 ] || { source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker \
-	  && rosrun mono_plane_detection benchmark_planes; }
+	@[ "$(BENCH_ALL)" != 1 ] || { source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker; }
 
 eval: build
 	@source $(DEVEL) && scripts/eval_two_view $(DATA)
