@@ -6,6 +6,7 @@
 #include <ros/console.h>
 
 #include <string>
+#include <utility>
 
 namespace mono_plane_detection {
 
