@@ -14,6 +14,7 @@
 #include "../src/sequence/ground_truth.h"
 #include "../src/sequence/sequence_writer.h"
 #include "mono_plane_detection/PlaneArray.h"
+#include "test_timeouts.h"
 
 using namespace mono_plane_detection;
 
@@ -37,14 +38,12 @@ TEST(PlaneAccuracy, RenderedSequence) {
   ros::Subscriber sub = nh.subscribe<PlaneArray>(
       "/camera/planes", 50,
       [&](const PlaneArrayConstPtr& m) { planes[m->header.stamp.toNSec()] = m; });
-  const ros::WallTime ready = ros::WallTime::now() + ros::WallDuration(30);
-  while (ros::ok() &&
-         (image_pub.getNumSubscribers() == 0 || info_pub.getNumSubscribers() == 0 ||
-          sub.getNumPublishers() == 0) &&
-         ros::WallTime::now() < ready) {
-    ros::spinOnce();
-    ros::WallDuration(0.05).sleep();
-  }
+  spinUntil(
+      [&] {
+        return image_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
+               sub.getNumPublishers() > 0;
+      },
+      30.0);
   ASSERT_GT(image_pub.getNumSubscribers(), 0u) << "the pipeline never subscribed";
 
   // Play the bag image by image, each after the previous one's planes arrived: the
@@ -64,11 +63,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     image_pub.publish(image);
     ++images;
     const uint64_t key = image->header.stamp.toNSec();
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(10);
-    while (ros::ok() && !planes.count(key) && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      ros::WallDuration(0.001).sleep();
-    }
+    spinUntil([&] { return planes.count(key) > 0; }, 10.0);
     ASSERT_TRUE(planes.count(key)) << "no planes for image " << images;
     last = planes[key];
     if (last->metric)

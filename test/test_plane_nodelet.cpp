@@ -69,15 +69,13 @@ class PlaneNodeletTest : public ::testing::Test {
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 20);
     planes_sub_ = nh_.subscribe("planes", 50, &PlaneNodeletTest::onPlanes, this);
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
-    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(20.0);
     // Both nodelets live in one manager process: one connection.
-    while (ros::ok() &&
-           (tracks_pub_.getNumSubscribers() == 0 || planes_sub_.getNumPublishers() == 0 ||
-            no_info_sub_.getNumPublishers() == 0) &&
-           ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      ros::WallDuration(0.05).sleep();
-    }
+    spinUntil(
+        [&] {
+          return tracks_pub_.getNumSubscribers() > 0 && planes_sub_.getNumPublishers() > 0 &&
+                 no_info_sub_.getNumPublishers() > 0;
+        },
+        20.0);
     ASSERT_GT(tracks_pub_.getNumSubscribers(), 0u) << "plane nodelets never subscribed";
   }
 
@@ -86,14 +84,8 @@ class PlaneNodeletTest : public ::testing::Test {
 
   template <typename T>
   T waitFor(const std::map<uint64_t, T>& store, uint64_t key, double timeout = 10.0) {
-    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(timeout);
-    while (ros::ok() && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      const auto it = store.find(key);
-      if (it != store.end()) return it->second;
-      ros::WallDuration(0.002).sleep();
-    }
-    return nullptr;
+    if (!spinUntil([&] { return store.count(key) > 0; }, timeout)) return nullptr;
+    return store.at(key);
   }
 
   // Publishes and waits for the planes of this stamp; null when none came.
@@ -287,11 +279,7 @@ TEST_F(PlaneNodeletTest, G_DebugImageWhileWatched) {
   sensor_msgs::ImageConstPtr drawn;
   ros::Subscriber debug = nh_.subscribe<sensor_msgs::Image>(
       "debug_image", 2, [&](const sensor_msgs::ImageConstPtr& m) { drawn = m; });
-  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(10.0);
-  while (image_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    ros::WallDuration(0.05).sleep();
-  }
+  spinUntil([&] { return image_pub_.getNumSubscribers() > 0; }, 10.0);
   ASSERT_GT(image_pub_.getNumSubscribers(), 0u) << "the nodelet did not subscribe to the image";
   for (int k = 0; k < 20 && !drawn; ++k) {
     TrackFrame f = world_->frame(2.0 + k / 30.0);
@@ -332,11 +320,7 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  const ros::WallTime ready = ros::WallTime::now() + scaledWait(10);
-  while (tracks.getNumSubscribers() == 0 && ros::WallTime::now() < ready) {
-    ros::spinOnce();
-    ros::WallDuration(0.05).sleep();
-  }
+  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
@@ -380,11 +364,7 @@ TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
   ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load));
   ASSERT_TRUE(load.response.success);
   info_pub_.publish(cameraInfo(world_->camera));  // latched: the new instance gets it
-  const ros::WallTime ready = ros::WallTime::now() + scaledWait(10);
-  while (planes_sub_.getNumPublishers() == 0 && ros::WallTime::now() < ready) {
-    ros::spinOnce();
-    ros::WallDuration(0.05).sleep();
-  }
+  spinUntil([&] { return planes_sub_.getNumPublishers() > 0; }, 10.0);
   scaledWait(1.0).sleep();
   const PlaneArrayConstPtr first = drive(0, 1, 800);
   ASSERT_TRUE(first) << "the reloaded nodelet does not answer";

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "../src/sequence/sequence_writer.h"
+#include "test_timeouts.h"
 
 using namespace mono_plane_detection;
 
@@ -37,11 +38,7 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
 
   // -d 2: rosbag play waits after advertising so that the subscribers connect.
   std::thread player([&] { EXPECT_EQ(std::system(("rosbag play -q -d 2 " + bag).c_str()), 0); });
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
-  while (ros::ok() && image_stamps.size() < 30 && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    ros::WallDuration(0.01).sleep();
-  }
+  spinUntil([&] { return image_stamps.size() >= 30; }, 30.0);
   player.join();
   ros::spinOnce();
   ASSERT_EQ(image_stamps.size(), 30u);

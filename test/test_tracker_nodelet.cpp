@@ -27,11 +27,7 @@ class TrackerNodeletTest : public ::testing::Test {
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 10);
     tracks_sub_ = nh_.subscribe("tracks", 50, &TrackerNodeletTest::onTracks, this);
     // The nodelet subscribes lazily: wait until our listener made it subscribe.
-    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(20.0);
-    while (ros::ok() && image_pub_.getNumSubscribers() == 0 && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      ros::WallDuration(0.05).sleep();
-    }
+    spinUntil([&] { return image_pub_.getNumSubscribers() > 0; }, 20.0);
     ASSERT_GT(image_pub_.getNumSubscribers(), 0u) << "tracker never subscribed to image";
   }
 
@@ -48,14 +44,8 @@ class TrackerNodeletTest : public ::testing::Test {
   TracksConstPtr send(const sensor_msgs::ImagePtr& msg, double timeout = 5.0) {
     image_pub_.publish(msg);
     const auto key = msg->header.stamp.toNSec();
-    const ros::WallTime deadline = ros::WallTime::now() + scaledWait(timeout);
-    while (ros::ok() && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      auto it = received_.find(key);
-      if (it != received_.end()) return it->second;
-      ros::WallDuration(0.005).sleep();
-    }
-    return nullptr;
+    if (!spinUntil([&] { return received_.count(key) > 0; }, timeout)) return nullptr;
+    return received_.at(key);
   }
 
   cv::Mat view(const cv::Point2d& shift) {
@@ -288,20 +278,12 @@ TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
   sensor_msgs::ImageConstPtr debug;
   ros::Subscriber sub = nh_.subscribe<sensor_msgs::Image>(
       "debug_image", 5, [&](const sensor_msgs::ImageConstPtr& m) { debug = m; });
-  const ros::WallTime connect_deadline = ros::WallTime::now() + scaledWait(5.0);
-  while (sub.getNumPublishers() == 0 && ros::WallTime::now() < connect_deadline) {
-    ros::spinOnce();
-    ros::WallDuration(0.02).sleep();
-  }
+  spinUntil([&] { return sub.getNumPublishers() > 0; }, 5.0);
   ASSERT_GT(sub.getNumPublishers(), 0u);
   scaledWait(0.3).sleep();  // let the nodelet see its new subscriber
   const double stamp = stamp_ += 0.1;
   ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp)));
-  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(5.0);
-  while (!debug && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    ros::WallDuration(0.01).sleep();
-  }
+  spinUntil([&] { return debug != nullptr; }, 5.0);
   ASSERT_TRUE(debug);
   EXPECT_EQ(debug->encoding, "bgr8");
   EXPECT_EQ(debug->width, 640u);
