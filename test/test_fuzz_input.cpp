@@ -27,6 +27,16 @@ TEST(FuzzInput, ReadsFloatsThenStopsAtTheEnd) {
   EXPECT_EQ(in.left(), 0u);
 }
 
+TEST(FuzzInput, ReadsPointsXFirst) {
+  const float values[] = {3.0f, 4.0f, 5.0f};
+  std::vector<uint8_t> bytes(sizeof values);
+  std::memcpy(bytes.data(), values, sizeof values);
+  FuzzInput in(bytes.data(), bytes.size());
+  EXPECT_EQ(in.nextPoint(), cv::Point2d(3, 4));
+  EXPECT_EQ(in.nextPoint(), cv::Point2d(5, 0));  // y ran out
+  EXPECT_TRUE(in.empty());
+}
+
 TEST(FuzzInput, ReadsBytesInOrder) {
   const std::vector<uint8_t> bytes = {7, 8};
   FuzzInput in(bytes.data(), bytes.size());

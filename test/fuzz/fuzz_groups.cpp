@@ -11,8 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzInput in(data, size);
   std::vector<cv::Point2d> a, b;
   while (in.left() >= 16 && a.size() < 200) {
-    a.emplace_back(in.nextFloat(), in.nextFloat());
-    b.emplace_back(in.nextFloat(), in.nextFloat());
+    a.push_back(in.nextPoint());
+    b.push_back(in.nextPoint());
   }
   if (a.size() >= 5) {
     const std::array<cv::Point2d, 5> p{a[0], a[1], a[2], a[3], a[4]};

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <opencv2/core/types.hpp>
 
 namespace mono_plane_detection {
 
@@ -22,6 +23,11 @@ class FuzzInput {
       pos_ = size_;
     }
     return f;
+  }
+  // Two floats as a point, x first (function arguments have no set evaluation order).
+  cv::Point2d nextPoint() {
+    const double x = nextFloat();
+    return {x, nextFloat()};
   }
   uint8_t nextByte() { return pos_ < size_ ? data_[pos_++] : 0; }
 

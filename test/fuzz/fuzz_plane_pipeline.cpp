@@ -20,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const int n = in.nextByte() % 64;
     for (int i = 0; i < n; ++i) {
       f.ids.push_back(in.nextByte() % 80);  // repeats are likely: validation must catch them
-      f.pixels.emplace_back(in.nextFloat(), in.nextFloat());
+      f.pixels.push_back(in.nextPoint());
       f.target_corner.push_back(in.nextByte() % 8 == 0);
     }
     if (!validateTrackFrame(f).empty()) continue;  // the nodelet drops these

@@ -10,8 +10,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzInput in(data, size);
   std::vector<cv::Point2d> a, b;
   while (in.left() >= 16 && a.size() < 300) {
-    a.emplace_back(in.nextFloat(), in.nextFloat());
-    b.emplace_back(in.nextFloat(), in.nextFloat());
+    a.push_back(in.nextPoint());
+    b.push_back(in.nextPoint());
   }
   PlaneParams params;
   params.groups.max_tries = 500;
