@@ -16,7 +16,7 @@ libs=($(pkg-config --libs opencv4))
 
 # The core, instrumented for coverage and sanitizers (rebuilt when a source is newer).
 objects=()
-for src in "$repo"/src/core/*.cpp; do
+for src in "$repo"/src/{geometry,tracking,planes,mapping,viz,sim,eval}/*.cpp; do
   obj=$out/obj/$(basename "${src%.cpp}").o
   if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find "$repo/include" -newer "$obj" -print -quit)" ]; then
     "$CXX" "${flags[@]}" -fsanitize=fuzzer-no-link,address,undefined -c "$src" -o "$obj"

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "mono_plane_detection/draw_planes.h"
+#include "mono_plane_detection/viz/draw_planes.h"
 
 namespace mono_plane_detection {
 

@@ -11,7 +11,7 @@
 
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
-#include "mono_plane_detection/plane_pipeline.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
 
 namespace mono_plane_detection {
 

@@ -14,7 +14,7 @@
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
 
-#include "mono_plane_detection/draw_planes.h"
+#include "mono_plane_detection/viz/draw_planes.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "mono_plane_detection/plane_pipeline.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
 
 namespace mono_plane_detection {
 

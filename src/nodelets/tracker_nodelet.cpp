@@ -12,9 +12,9 @@
 
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
-#include "mono_plane_detection/draw_tracks.h"
-#include "mono_plane_detection/feature_tracker.h"
-#include "mono_plane_detection/target_startup.h"
+#include "mono_plane_detection/viz/draw_tracks.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/tracking/target_startup.h"
 #include "nodelet_diagnostics.h"
 #include "param_check.h"
 

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "mono_plane_detection/feature_tracker.h"
-#include "mono_plane_detection/homography_voting.h"
-#include "mono_plane_detection/synthetic_two_view.h"
-#include "mono_plane_detection/synthetic_views.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/planes/homography_voting.h"
+#include "mono_plane_detection/sim/synthetic_two_view.h"
+#include "mono_plane_detection/sim/synthetic_views.h"
 
 using namespace mono_plane_detection;
 using Clock = std::chrono::steady_clock;

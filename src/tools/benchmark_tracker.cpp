@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "mono_plane_detection/feature_tracker.h"
-#include "mono_plane_detection/synthetic_views.h"
-#include "mono_plane_detection/track_scorer.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/sim/synthetic_views.h"
+#include "mono_plane_detection/eval/track_scorer.h"
 
 using namespace mono_plane_detection;
 

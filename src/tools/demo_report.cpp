@@ -15,9 +15,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "../sequence/ground_truth.h"
+#include "../sim/bag/ground_truth.h"
 #include "mono_plane_detection/Tracks.h"
-#include "mono_plane_detection/draw_planes.h"
+#include "mono_plane_detection/viz/draw_planes.h"
 
 using namespace mono_plane_detection;
 

@@ -5,7 +5,7 @@
 #include <map>
 #include <string>
 
-#include "../sequence/sequence_writer.h"
+#include "../sim/bag/sequence_writer.h"
 #include "cli_args.h"
 
 using namespace mono_plane_detection;

@@ -9,11 +9,11 @@
 #include <string>
 
 #include "cli_args.h"
-#include "mono_plane_detection/camera_trajectory.h"
-#include "mono_plane_detection/map_evaluation.h"
-#include "mono_plane_detection/plane_pipeline.h"
-#include "mono_plane_detection/scene_renderer.h"
-#include "mono_plane_detection/target_startup.h"
+#include "mono_plane_detection/sim/camera_trajectory.h"
+#include "mono_plane_detection/eval/map_evaluation.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
+#include "mono_plane_detection/sim/scene_renderer.h"
+#include "mono_plane_detection/tracking/target_startup.h"
 
 using namespace mono_plane_detection;
 

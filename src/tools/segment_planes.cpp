@@ -10,8 +10,8 @@
 #include <string>
 
 #include "cli_args.h"
-#include "mono_plane_detection/correspondence_io.h"
-#include "mono_plane_detection/homography_voting.h"
+#include "mono_plane_detection/planes/correspondence_io.h"
+#include "mono_plane_detection/planes/homography_voting.h"
 
 using namespace mono_plane_detection;
 

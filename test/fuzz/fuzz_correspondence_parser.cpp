@@ -2,7 +2,7 @@
 #include <sstream>
 #include <string>
 
-#include "mono_plane_detection/correspondence_io.h"
+#include "mono_plane_detection/planes/correspondence_io.h"
 
 using namespace mono_plane_detection;
 

@@ -2,8 +2,8 @@
 #include <vector>
 
 #include "fuzz_input.h"
-#include "mono_plane_detection/coplanar_groups.h"
-#include "mono_plane_detection/cross_ratio.h"
+#include "mono_plane_detection/planes/coplanar_groups.h"
+#include "mono_plane_detection/planes/cross_ratio.h"
 
 using namespace mono_plane_detection;
 

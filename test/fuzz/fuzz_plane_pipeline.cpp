@@ -2,7 +2,7 @@
 #include <vector>
 
 #include "fuzz_input.h"
-#include "mono_plane_detection/plane_pipeline.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
 
 using namespace mono_plane_detection;
 

@@ -2,7 +2,7 @@
 #include <vector>
 
 #include "fuzz_input.h"
-#include "mono_plane_detection/homography_voting.h"
+#include "mono_plane_detection/planes/homography_voting.h"
 
 using namespace mono_plane_detection;
 

@@ -2,7 +2,7 @@
 #include <opencv2/core.hpp>
 
 #include "fuzz_input.h"
-#include "mono_plane_detection/target_detector.h"
+#include "mono_plane_detection/tracking/target_detector.h"
 
 using namespace mono_plane_detection;
 

@@ -7,7 +7,7 @@
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
 
-#include "mono_plane_detection/indoor_scene.h"
+#include "mono_plane_detection/geometry/pose.h"
 
 namespace mono_plane_detection {
 

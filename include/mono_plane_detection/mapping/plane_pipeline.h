@@ -1,0 +1,86 @@
+// The plane stage as one object: each image's tracks are compared with an earlier
+// image's (paper III: five-point groups, invariants, homography votes; here every
+// dominant plane), the camera is placed in the metric map (PoseEstimator) and the
+// planes are fused into the map (PlaneMap). The plane nodelet and the offline tools
+// only feed it frames. ROS-free.
+#pragma once
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mono_plane_detection/planes/homography_voting.h"
+#include "mono_plane_detection/mapping/plane_map.h"
+#include "mono_plane_detection/mapping/pose_estimator.h"
+#include "mono_plane_detection/tracking/target_detector.h"
+#include "mono_plane_detection/tracking/track_frame.h"
+
+namespace mono_plane_detection {
+
+struct PipelineParams {
+  PlaneParams planes;
+  PoseParams pose;
+  MapParams map;
+  TargetParams target;
+  int frame_gap = 5;       // compare each image with the one this many images before
+  double max_gap_s = 1.0;  // a longer pause between images is a tracking loss
+};
+
+// Empty when K and the distortion describe a usable camera, else why not.
+std::string cameraIntrinsicsError(const cv::Matx33d& K, const cv::Mat& distortion);
+
+// A plane found in this image (image space).
+struct ImagePlane {
+  int id = 0;     // stable while the plane keeps most of its tracks
+  cv::Matx33d H;  // reference image pixel -> this image pixel
+  std::vector<std::uint64_t> inlier_ids;
+  double rms_error_px = 0;
+  int map_id = -1;  // the map plane it was fused into, -1 when none
+};
+
+enum class PipelineState { kNoCamera, kWaitingForTarget, kInitialising, kLost, kTracking };
+
+struct PipelineResult {
+  PipelineState state = PipelineState::kNoCamera;
+  std::string status;                // for people: "waiting for target", ...
+  bool was_reset = false;            // time went backwards: everything started again
+  bool tracking_loss = false;        // the pause since the last image exceeded max_gap_s
+  std::optional<PoseEstimate> pose;  // this image's camera in the map
+  std::vector<ImagePlane> planes;    // largest first
+  double reference_stamp = -1;       // image the homographies start from, -1 none
+  TrackPairs pairs;             // reference/current pixels the planes were found in
+  PlaneSegmentation segmentation;    // over `pairs`
+};
+
+class PlanePipeline {
+ public:
+  explicit PlanePipeline(const PipelineParams& params = PipelineParams());
+
+  // Sets the intrinsics (checked by cameraIntrinsicsError first); a change of camera
+  // restarts the metric part.
+  void setCamera(const cv::Matx33d& K, const cv::Mat& distortion);
+  bool hasCamera() const { return pose_.has_value(); }
+
+  // Frames must be valid (validateTrackFrame). odom_from_camera: robot odometry, if any.
+  PipelineResult process(const TrackFrame& frame, const std::optional<Pose>& odom_from_camera = {});
+
+  const PlaneMap& map() const { return map_; }
+  const PoseEstimator* poseEstimator() const { return pose_ ? &*pose_ : nullptr; }
+  const PipelineParams& params() const { return params_; }
+  void reset();
+
+ private:
+  void assignImageIds(std::vector<ImagePlane>& planes);
+
+  PipelineParams params_;
+  std::optional<PoseEstimator> pose_;
+  cv::Matx33d K_;
+  cv::Mat distortion_;
+  PlaneMap map_;
+  std::deque<TrackFrame> history_;
+  std::vector<ImagePlane> previous_planes_;
+  int next_image_id_ = 1;
+};
+
+}  // namespace mono_plane_detection

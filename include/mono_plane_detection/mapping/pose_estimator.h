@@ -1,0 +1,114 @@
+// The camera's pose in the metric map over time (beyond the paper, which stops at
+// image-space planes): the start-up target's corners fix pose and scale, tracks are
+// triangulated into landmarks once they have seen enough parallax, and the landmarks
+// place the camera (PnP) after the target has left the view. Optionally an odometry
+// pose (odom -> camera) replaces the visual estimate, the target fixing map -> odom.
+// ROS-free.
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "mono_plane_detection/geometry/pose.h"
+#include "mono_plane_detection/tracking/target_detector.h"
+#include "mono_plane_detection/tracking/track_frame.h"
+#include "mono_plane_detection/mapping/two_view_init.h"
+
+namespace mono_plane_detection {
+
+struct PoseParams {
+  double min_parallax_deg = 3.0;      // triangulate a track once its two rays differ this much
+  double retriangulate_factor = 1.5;  // and again each time its parallax grows by this factor
+  double max_reprojection_px = 2.0;   // PnP inliers and triangulation check
+  int min_pnp_points = 8;             // landmarks needed to place the camera without the target
+  double min_inlier_share = 0.5;      // of the landmarks in view, else the PnP pose is refused
+  double max_jump_m = 0.5;            // a PnP pose further than this from the last one is refused
+  double min_depth_m = 0.05;          // triangulated points must be this far in front of both views
+  size_t max_landmarks = 5000;        // least recently seen are dropped beyond this
+  TwoViewParams two_view;             // the metric start (two_view_init.h)
+};
+
+// A track's 3D point. Before triangulation only its first observation with a known
+// camera pose (the anchor) is known.
+struct Landmark {
+  bool triangulated = false;
+  bool fixed = false;             // a target corner: position known exactly
+  cv::Vec3d position;             // map frame, m (when triangulated or fixed)
+  Pose anchor_pose;               // map_from_camera at the anchor observation
+  cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
+  double parallax_deg = 0;        // between the two rays of the triangulation
+  double last_seen = 0;           // stamp, s
+};
+
+enum class PoseSource { kTarget, kLandmarks, kOdometry };
+const char* toString(PoseSource source);
+
+struct PoseEstimate {
+  Pose map_from_camera;
+  PoseSource source = PoseSource::kTarget;
+  int points = 0;     // correspondences behind it (PnP inliers, target corners)
+  double rms_px = 0;  // their reprojection error
+};
+
+class PoseEstimator {
+ public:
+  PoseEstimator(const cv::Matx33d& K, const cv::Mat& distortion,
+                const PoseParams& params = PoseParams(),
+                const TargetParams& target = TargetParams());
+
+  // The camera's pose for this frame, nothing while it cannot be known (target not seen
+  // yet, start not done: not enough motion yet, too few landmarks). Triangulates new
+  // landmarks when the pose is known.
+  // odom_from_camera: the robot's odometry for this frame, when it has one.
+  std::optional<PoseEstimate> update(const TrackFrame& frame,
+                                     const std::optional<Pose>& odom_from_camera = {});
+
+  // True once the target has been seen: poses are in metres.
+  bool scaleKnown() const { return !target_ids_.empty(); }
+  // True once the two-view start has placed the first landmarks (before that the pose
+  // comes from the target alone and nothing is triangulated).
+  bool initialised() const { return initialised_; }
+  const std::unordered_map<std::uint64_t, Landmark>& landmarks() const { return landmarks_; }
+  // Triangulated (or fixed) landmark position of a track, if any.
+  std::optional<cv::Vec3d> landmarkPosition(std::uint64_t id) const;
+  // After a pause (tracking loss) the last pose is no guide to the next.
+  void forgetLastPose() { last_pose_.reset(); }
+  void reset();
+
+ private:
+  std::optional<PoseEstimate> visualPose(const TrackFrame& frame,
+                                         const std::vector<cv::Point2d>& normalized);
+  void triangulate(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                   const Pose& map_from_camera);
+  std::optional<PoseEstimate> initialise(const TrackFrame& frame,
+                                         const std::vector<cv::Point2d>& normalized);
+  std::optional<PoseEstimate> targetPose(const TrackFrame& frame) const;
+  void forgetOldLandmarks();
+
+  struct FirstView {  // the image the two-view start measures motion from
+    std::vector<std::uint64_t> ids;
+    std::vector<cv::Point2d> normalized;
+    // Its target corners, averaged over the later images carried back by the wall's
+    // homography (two_view_init.h explains why).
+    std::array<cv::Point2d, 4> corner_sum{};
+    int corner_count = 0;
+  };
+  FirstView firstView(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const;
+
+  cv::Matx33d K_;
+  cv::Mat distortion_;
+  PoseParams params_;
+  TargetParams target_;
+  std::vector<std::uint64_t> target_ids_;  // in TargetDetection's corner order
+  std::unordered_map<std::uint64_t, Landmark> landmarks_;
+  std::optional<Pose> last_pose_;
+  std::optional<Pose> map_from_odom_;
+  bool initialised_ = false;
+  std::optional<FirstView> first_view_;
+};
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,64 @@
+#include "mono_plane_detection/geometry/homography_fit.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace mono_plane_detection {
+namespace {
+
+// Similarity that moves the points' centroid to 0 and their mean distance to sqrt(2).
+std::optional<Eigen::Matrix3d> normaliser(const std::vector<cv::Point2d>& p) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& q : p) mean += Eigen::Vector2d(q.x, q.y);
+  mean /= static_cast<double>(p.size());
+  double spread = 0.0;
+  for (const auto& q : p) spread += (Eigen::Vector2d(q.x, q.y) - mean).norm();
+  spread /= static_cast<double>(p.size());
+  if (!(spread > 1e-12) || !std::isfinite(spread)) return std::nullopt;
+  const double s = std::sqrt(2.0) / spread;
+  Eigen::Matrix3d T;
+  T << s, 0, -s * mean.x(), 0, s, -s * mean.y(), 0, 0, 1;
+  return T;
+}
+
+}  // namespace
+
+std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
+                                         const std::vector<cv::Point2d>& to,
+                                         const std::vector<double>& weights) {
+  const size_t n = from.size();
+  if (n < 4 || to.size() != n || (!weights.empty() && weights.size() != n)) return std::nullopt;
+  const auto Tf = normaliser(from);
+  const auto Tt = normaliser(to);
+  if (!Tf || !Tt) return std::nullopt;
+
+  // The normal matrix A^T W A summed over points: fixed-size rank-2 updates, lazily
+  // evaluated, so nothing is allocated (this runs for hundreds of 5-point groups).
+  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
+  Eigen::Matrix<double, 2, 9> rows;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
+    const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
+    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(), a.x(), a.y(), 1, 0, 0,
+        0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
+    const double w = weights.empty() ? 1.0 : weights[i];
+    normal.noalias() += (w * rows.transpose()).lazyProduct(rows);
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
+  if (solver.info() != Eigen::Success) return std::nullopt;
+  // A second (near-)zero eigenvalue means the points do not fix H (e.g. collinear).
+  const auto& values = solver.eigenvalues();
+  if (values(1) <= 1e-12 * std::max(1.0, values(8))) return std::nullopt;
+  const Eigen::Matrix<double, 9, 1> h = solver.eigenvectors().col(0);
+  Eigen::Matrix3d Hn;
+  Hn << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
+  Eigen::Matrix3d H = Tt->inverse() * Hn * *Tf;
+  if (std::abs(H(2, 2)) > 1e-15) H /= H(2, 2);
+  if (!H.allFinite()) return std::nullopt;
+  cv::Matx33d out;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out(r, c) = H(r, c);
+  return out;
+}
+
+}  // namespace mono_plane_detection

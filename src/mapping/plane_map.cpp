@@ -1,0 +1,214 @@
+#include "mono_plane_detection/mapping/plane_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mono_plane_detection/geometry/plane_fit.h"
+
+namespace mono_plane_detection {
+namespace {
+
+double meanAbsResidual(const cv::Vec3d& normal, double distance,
+                       const std::vector<cv::Vec3d>& points) {
+  double sum = 0;
+  for (const auto& p : points) sum += std::abs(normal.dot(p) - distance);
+  return points.empty() ? 0 : sum / static_cast<double>(points.size());
+}
+
+std::vector<cv::Vec3d> positions(const MapPlane& plane) {
+  std::vector<cv::Vec3d> out;
+  out.reserve(plane.points.size());
+  for (const auto& [id, entry] : plane.points) out.push_back(entry.first);
+  return out;
+}
+
+}  // namespace
+
+void PlaneMap::reset() {
+  planes_.clear();
+  next_id_ = 1;
+}
+
+std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observations, double stamp) {
+  std::vector<int> ids(observations.size(), -1);
+  cv::Vec3d viewpoint(0, 0, 0);
+  for (size_t k = 0; k < observations.size(); ++k) {
+    const PlaneObservation& obs = observations[k];
+    viewpoint = obs.viewpoint;
+    const int needed = std::max(params_.min_points,
+                                static_cast<int>(std::ceil(params_.min_share * obs.points.size())));
+    PlaneObservation rest = obs;
+    size_t largest = 0;
+    while (static_cast<int>(rest.points.size()) >= needed) {
+      PlaneFit fit = fitPlane(rest.points, params_.max_residual_m, needed);
+      if (!fit.ok) break;
+      orientTowards(fit, obs.viewpoint);
+      PlaneObservation kept, others;
+      kept.viewpoint = others.viewpoint = obs.viewpoint;
+      std::vector<bool> in(rest.points.size(), false);
+      for (int i : fit.inliers) in[i] = true;
+      for (size_t i = 0; i < rest.points.size(); ++i) {
+        PlaneObservation& to = in[i] ? kept : others;
+        to.ids.push_back(rest.ids[i]);
+        to.points.push_back(rest.points[i]);
+      }
+      const int id = fuse(kept, fit.normal, fit.distance, stamp);
+      if (id >= 0 && kept.points.size() > largest) {
+        largest = kept.points.size();
+        ids[k] = id;
+      }
+      rest = std::move(others);
+    }
+  }
+  mergeDuplicates(viewpoint);
+  fadeAndBound(stamp);
+  // A merge may have renamed a plane an observation went to.
+  for (int& id : ids) {
+    if (id < 0) continue;
+    const bool alive =
+        std::any_of(planes_.begin(), planes_.end(), [&](const MapPlane& p) { return p.id == id; });
+    if (!alive) id = -1;
+  }
+  return ids;
+}
+
+int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance,
+                   double stamp) {
+  const int match = associate(normal, distance, kept);
+  MapPlane* plane;
+  if (match < 0) {
+    planes_.emplace_back();
+    plane = &planes_.back();
+    plane->id = next_id_++;
+    plane->first_seen = stamp;
+    plane->normal = normal;
+    plane->distance = distance;
+  } else {
+    plane = &planes_[match];
+  }
+  for (size_t i = 0; i < kept.ids.size(); ++i) plane->points[kept.ids[i]] = {kept.points[i], stamp};
+  if (!refit(*plane, kept.viewpoint)) {
+    if (match < 0) {
+      planes_.pop_back();
+      --next_id_;
+    }
+    return -1;
+  }
+  plane->observations += 1;
+  plane->last_seen = stamp;
+  return plane->id;
+}
+
+int PlaneMap::associate(const cv::Vec3d& normal, double distance,
+                        const PlaneObservation& obs) const {
+  int best = -1;
+  double best_score = 0;
+  for (size_t k = 0; k < planes_.size(); ++k) {
+    const MapPlane& plane = planes_[k];
+    // Tracks already on a plane are strong evidence; geometry decides otherwise.
+    size_t shared = 0;
+    for (auto id : obs.ids) shared += plane.points.count(id);
+    const double share = obs.ids.empty() ? 0 : double(shared) / double(obs.ids.size());
+    double score = 0;
+    const bool parallel = normalAngleDeg(normal, plane.normal) <= params_.max_angle_deg;
+    const double offset = meanAbsResidual(plane.normal, plane.distance, obs.points);
+    if (share >= params_.min_shared_ids && parallel)
+      score = 1 + share;
+    else if (parallel && offset <= params_.max_offset_m &&
+             std::abs(distance - plane.distance) <= 2 * params_.max_offset_m)
+      score = 1 - offset / params_.max_offset_m;
+    if (score > best_score) {
+      best_score = score;
+      best = static_cast<int>(k);
+    }
+  }
+  return best;
+}
+
+bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
+  // Bound the memory: keep the most recently seen points.
+  if (plane.points.size() > params_.max_points_per_plane) {
+    std::vector<std::pair<double, std::uint64_t>> by_age;
+    for (const auto& [id, entry] : plane.points) by_age.emplace_back(entry.second, id);
+    std::sort(by_age.begin(), by_age.end());
+    for (size_t k = 0; plane.points.size() > params_.max_points_per_plane; ++k)
+      plane.points.erase(by_age[k].second);
+  }
+  const std::vector<cv::Vec3d> all = positions(plane);
+  PlaneFit fit = fitPlane(all, params_.max_residual_m, params_.min_points);
+  if (!fit.ok) return false;
+  orientTowards(fit, viewpoint);
+  if (normalAngleDeg(fit.normal, plane.normal) > 90) {  // keep the side first seen
+    fit.normal = -fit.normal;
+    fit.distance = -fit.distance;
+  }
+  // Points the refit does not explain were put on this plane by mistake.
+  std::vector<bool> keep(all.size(), false);
+  for (int i : fit.inliers) keep[i] = true;
+  size_t index = 0;
+  std::vector<cv::Vec3d> inliers;
+  for (auto it = plane.points.begin(); it != plane.points.end(); ++index) {
+    if (keep[index]) {
+      inliers.push_back(it->second.first);
+      ++it;
+    } else {
+      it = plane.points.erase(it);
+    }
+  }
+  plane.normal = fit.normal;
+  plane.distance = fit.distance;
+  plane.rms_m = fit.rms_m;
+  plane.polygon = planePolygon(fit.normal, fit.distance, inliers);
+  return true;
+}
+
+void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
+  for (size_t i = 0; i < planes_.size(); ++i) {
+    for (size_t j = i + 1; j < planes_.size();) {
+      MapPlane& a = planes_[i];
+      const MapPlane& b = planes_[j];
+      const bool same =
+          normalAngleDeg(a.normal, b.normal) <= params_.max_angle_deg &&
+          meanAbsResidual(a.normal, a.distance, positions(b)) <= params_.max_offset_m &&
+          meanAbsResidual(b.normal, b.distance, positions(a)) <= params_.max_offset_m;
+      if (!same) {
+        ++j;
+        continue;
+      }
+      // The older plane (smaller id) keeps its id: ids stay stable for users.
+      MapPlane merged = a;
+      for (const auto& [id, entry] : b.points) merged.points.emplace(id, entry);
+      merged.observations += b.observations;
+      merged.first_seen = std::min(a.first_seen, b.first_seen);
+      merged.last_seen = std::max(a.last_seen, b.last_seen);
+      if (refit(merged, viewpoint)) {
+        a = merged;
+        planes_.erase(planes_.begin() + static_cast<long>(j));
+      } else {
+        ++j;
+      }
+    }
+  }
+}
+
+void PlaneMap::fadeAndBound(double stamp) {
+  for (auto& p : planes_) {
+    const double unseen = std::max(0.0, stamp - p.last_seen);
+    p.confidence = (1 - std::exp(-double(p.observations) / params_.confirm_observations)) *
+                   std::exp(-unseen / params_.fade_time_s);
+  }
+  planes_.erase(std::remove_if(planes_.begin(), planes_.end(),
+                               [&](const MapPlane& p) {
+                                 return !p.confirmed(params_) &&
+                                        stamp - p.last_seen > params_.tentative_timeout_s;
+                               }),
+                planes_.end());
+  while (planes_.size() > params_.max_planes) {
+    const auto weakest = std::min_element(
+        planes_.begin(), planes_.end(),
+        [](const MapPlane& a, const MapPlane& b) { return a.confidence < b.confidence; });
+    planes_.erase(weakest);
+  }
+}
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,313 @@
+#include "mono_plane_detection/mapping/pose_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+
+#include "mono_plane_detection/geometry/triangulation.h"
+
+namespace mono_plane_detection {
+namespace {
+
+cv::Vec3d unitRay(const Pose& map_from_camera, const cv::Point2d& n) {
+  const cv::Vec3d r = map_from_camera.R * cv::Vec3d(n.x, n.y, 1.0);
+  return r / cv::norm(r);
+}
+
+double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
+  return std::acos(std::max(-1.0, std::min(1.0, a.dot(b)))) * 180.0 / CV_PI;
+}
+
+cv::Matx34d cameraFromMap(const Pose& map_from_camera) {
+  const Pose c = map_from_camera.inverse();
+  return projectionMatrix(c.R, c.t);
+}
+
+}  // namespace
+
+const char* toString(PoseSource source) {
+  switch (source) {
+    case PoseSource::kTarget:
+      return "target";
+    case PoseSource::kLandmarks:
+      return "landmarks";
+    case PoseSource::kOdometry:
+      return "odometry";
+  }
+  return "?";
+}
+
+PoseEstimator::PoseEstimator(const cv::Matx33d& K, const cv::Mat& distortion,
+                             const PoseParams& params, const TargetParams& target)
+    : K_(K), distortion_(distortion.clone()), params_(params), target_(target) {}
+
+void PoseEstimator::reset() {
+  target_ids_.clear();
+  landmarks_.clear();
+  last_pose_.reset();
+  map_from_odom_.reset();
+  initialised_ = false;
+  first_view_.reset();
+}
+
+std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
+  const auto it = landmarks_.find(id);
+  if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed)) return {};
+  return it->second.position;
+}
+
+std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
+                                                  const std::optional<Pose>& odom_from_camera) {
+  if (frame.ids.empty()) return {};
+  // The target's corners become fixed landmarks whenever all four are tracked under new
+  // ids (the first time, and when the tracker found the target again after a loss); the
+  // tracker adds them in TargetDetection's order, so ascending ids give the corners.
+  std::vector<std::uint64_t> corners;
+  for (size_t i = 0; i < frame.ids.size(); ++i)
+    if (frame.target_corner[i]) corners.push_back(frame.ids[i]);
+  std::sort(corners.begin(), corners.end());
+  if (corners.size() == 4 && corners != target_ids_) {
+    const auto map_corners = targetCornersInMap(target_);
+    for (int k = 0; k < 4; ++k) {
+      Landmark& l = landmarks_[corners[k]];
+      l.fixed = true;
+      l.triangulated = false;
+      l.position = cv::Vec3d(map_corners[k].x, map_corners[k].y, map_corners[k].z);
+      l.last_seen = frame.stamp;
+    }
+    target_ids_ = corners;
+  }
+  if (target_ids_.empty()) return {};  // no metres without the target
+
+  std::vector<cv::Point2d> normalized;
+  cv::undistortPoints(frame.pixels, normalized, K_, distortion_);
+
+  if (!initialised_) {  // nothing is triangulated before the start
+    const std::optional<PoseEstimate> start = initialise(frame, normalized);
+    // With odometry, the start fixes where the odometry's origin sits in the map.
+    if (start && odom_from_camera)
+      map_from_odom_ = start->map_from_camera * odom_from_camera->inverse();
+    return start;
+  }
+  std::optional<PoseEstimate> estimate;
+  if (odom_from_camera && map_from_odom_)
+    estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
+  else
+    estimate = visualPose(frame, normalized);
+  if (!estimate) return {};
+  last_pose_ = estimate->map_from_camera;
+  for (size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto it = landmarks_.find(frame.ids[i]);
+    if (it != landmarks_.end()) it->second.last_seen = frame.stamp;
+  }
+  triangulate(frame, normalized, estimate->map_from_camera);
+  forgetOldLandmarks();
+  return estimate;
+}
+
+std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
+                                                      const std::vector<cv::Point2d>& normalized) {
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  std::vector<size_t> index;  // into the frame
+  std::array<int, 4> target_at{-1, -1, -1, -1};
+  for (size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto it = landmarks_.find(frame.ids[i]);
+    if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed)) continue;
+    for (int k = 0; k < 4; ++k)
+      if (frame.ids[i] == target_ids_[k]) target_at[k] = static_cast<int>(i);
+    const cv::Vec3d& x = it->second.position;
+    object.emplace_back(x[0], x[1], x[2]);
+    image.push_back(frame.pixels[i]);
+    index.push_back(i);
+  }
+  const bool whole_target =
+      std::all_of(target_at.begin(), target_at.end(), [](int i) { return i >= 0; });
+
+  if (static_cast<int>(object.size()) >= params_.min_pnp_points) {
+    cv::Mat rvec, tvec;
+    std::vector<int> inliers;
+    const bool ok = cv::solvePnPRansac(object, image, K_, distortion_, rvec, tvec, false, 100,
+                                       static_cast<float>(params_.max_reprojection_px), 0.99,
+                                       inliers, cv::SOLVEPNP_EPNP);
+    const int needed = std::max(6, static_cast<int>(std::ceil(params_.min_inlier_share *
+                                                              static_cast<double>(object.size()))));
+    if (ok && static_cast<int>(inliers.size()) >= needed) {
+      std::vector<cv::Point3d> obj_in;
+      std::vector<cv::Point2d> img_in;
+      std::vector<bool> inlier(object.size(), false);
+      for (int k : inliers) {
+        obj_in.push_back(object[k]);
+        img_in.push_back(image[k]);
+        inlier[k] = true;
+      }
+      cv::solvePnPRefineLM(obj_in, img_in, K_, distortion_, rvec, tvec);
+      cv::Matx33d R;
+      cv::Rodrigues(rvec, R);
+      const Pose map_from_camera =
+          Pose{R, cv::Vec3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2))}.inverse();
+      const bool jumped =
+          last_pose_ && cv::norm(map_from_camera.t - last_pose_->t) > params_.max_jump_m;
+      if (!jumped) {
+        std::vector<cv::Point2d> projected;
+        cv::projectPoints(obj_in, rvec, tvec, K_, distortion_, projected);
+        double sum = 0;
+        for (size_t k = 0; k < projected.size(); ++k) {
+          const cv::Point2d d = projected[k] - img_in[k];
+          sum += d.dot(d);
+        }
+        // Landmarks the pose disagrees with were triangulated wrongly: start them again.
+        int target_inliers = 0;
+        for (size_t k = 0; k < object.size(); ++k) {
+          Landmark& l = landmarks_[frame.ids[index[k]]];
+          if (l.fixed) {
+            target_inliers += inlier[k];
+          } else if (!inlier[k]) {
+            l.triangulated = false;
+            l.anchor_pose = map_from_camera;
+            l.anchor_normalized = normalized[index[k]];
+          }
+        }
+        PoseEstimate e;
+        e.map_from_camera = map_from_camera;
+        e.source = target_inliers == 4 ? PoseSource::kTarget : PoseSource::kLandmarks;
+        e.points = static_cast<int>(inliers.size());
+        e.rms_px = std::sqrt(sum / static_cast<double>(projected.size()));
+        return e;
+      }
+    }
+  }
+  if (whole_target) return targetPose(frame);
+  return {};
+}
+
+std::optional<PoseEstimate> PoseEstimator::targetPose(const TrackFrame& frame) const {
+  TargetDetection detection;
+  for (int k = 0; k < 4; ++k) {
+    const auto at = std::find(frame.ids.begin(), frame.ids.end(), target_ids_[k]);
+    if (at == frame.ids.end()) return {};
+    detection.corners[k] = frame.pixels[static_cast<size_t>(at - frame.ids.begin())];
+  }
+  detection.found = true;
+  const auto pose = cameraPoseFromTarget(detection, K_, distortion_, target_);
+  if (!pose || pose->reprojection_error_px > 2 * params_.max_reprojection_px) return {};
+  return PoseEstimate{pose->map_from_camera, PoseSource::kTarget, 4, pose->reprojection_error_px};
+}
+
+std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
+                                                      const std::vector<cv::Point2d>& normalized) {
+  // No pose is given out before the start succeeds: from one image the small target
+  // places the camera only to 0.1-0.3 m (its tilt is poorly defined, two_view_init.h).
+  if (!targetPose(frame)) {
+    first_view_.reset();  // the start needs the whole target in both views
+    return {};
+  }
+  if (!first_view_) {
+    first_view_ = firstView(frame, normalized);
+    return {};
+  }
+  std::unordered_map<std::uint64_t, size_t> in_first;
+  for (size_t i = 0; i < first_view_->ids.size(); ++i) in_first.emplace(first_view_->ids[i], i);
+  std::vector<cv::Point2d> a, b;
+  std::vector<std::uint64_t> ids;
+  std::array<int, 4> target{-1, -1, -1, -1};
+  for (size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto it = in_first.find(frame.ids[i]);
+    if (it == in_first.end()) continue;
+    for (int k = 0; k < 4; ++k)
+      if (frame.ids[i] == target_ids_[k]) target[k] = static_cast<int>(ids.size());
+    ids.push_back(frame.ids[i]);
+    a.push_back(first_view_->normalized[it->second]);
+    b.push_back(normalized[i]);
+  }
+  const bool target_in_both =
+      std::all_of(target.begin(), target.end(), [](int i) { return i >= 0; });
+  // Start again from this image when too few of the first view's tracks survive.
+  if (!target_in_both || ids.size() * 2 < first_view_->ids.size()) {
+    first_view_ = firstView(frame, normalized);
+    return {};
+  }
+  const TargetPlaneHomography wall =
+      targetPlaneHomography(a, b, target, K_(0, 0), params_.two_view);
+  if (wall.ok) {
+    const cv::Matx33d back = wall.H.inv();
+    for (int k = 0; k < 4; ++k) {
+      const cv::Vec3d p = back * cv::Vec3d(b[target[k]].x, b[target[k]].y, 1.0);
+      first_view_->corner_sum[k] += cv::Point2d(p[0] / p[2], p[1] / p[2]);
+    }
+    ++first_view_->corner_count;
+  }
+  std::array<cv::Point2d, 4> corners;
+  for (int k = 0; k < 4; ++k) corners[k] = first_view_->corner_sum[k] / first_view_->corner_count;
+  const TwoViewInit init =
+      initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view, corners);
+  if (!init.ok) return {};
+  for (size_t k = 0; k < init.points.size(); ++k) {
+    Landmark& l = landmarks_[ids[init.points[k]]];
+    l.triangulated = true;
+    l.position = init.points_map[k];
+    l.parallax_deg = init.parallax_deg;
+    l.anchor_pose = init.map_from_second;
+    l.anchor_normalized = b[init.points[k]];
+    l.last_seen = frame.stamp;
+  }
+  initialised_ = true;
+  first_view_.reset();
+  last_pose_ = init.map_from_second;
+  PoseEstimate e{init.map_from_second, PoseSource::kTarget, static_cast<int>(init.points.size()),
+                 0};
+  triangulate(frame, normalized, init.map_from_second);  // anchors for the other tracks
+  forgetOldLandmarks();
+  return e;
+}
+
+PoseEstimator::FirstView PoseEstimator::firstView(
+    const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const {
+  FirstView view{frame.ids, normalized, {}, 1};
+  for (size_t i = 0; i < frame.ids.size(); ++i)
+    for (int k = 0; k < 4; ++k)
+      if (frame.ids[i] == target_ids_[k]) view.corner_sum[k] = normalized[i];
+  return view;
+}
+
+void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                                const Pose& map_from_camera) {
+  const double max_error = params_.max_reprojection_px / K_(0, 0);
+  const cv::Matx34d P2 = cameraFromMap(map_from_camera);
+  for (size_t i = 0; i < frame.ids.size(); ++i) {
+    auto [it, is_new] = landmarks_.try_emplace(frame.ids[i]);
+    Landmark& l = it->second;
+    if (is_new) {
+      l.anchor_pose = map_from_camera;
+      l.anchor_normalized = normalized[i];
+      l.last_seen = frame.stamp;
+      continue;
+    }
+    if (l.fixed) continue;
+    const double parallax = angleDeg(unitRay(l.anchor_pose, l.anchor_normalized),
+                                     unitRay(map_from_camera, normalized[i]));
+    if (parallax < params_.min_parallax_deg) continue;
+    if (l.triangulated && parallax < params_.retriangulate_factor * l.parallax_deg) continue;
+    const auto p = mono_plane_detection::triangulate(cameraFromMap(l.anchor_pose), P2,
+                                                     l.anchor_normalized, normalized[i]);
+    if (!p || p->depth1 < params_.min_depth_m || p->depth2 < params_.min_depth_m ||
+        p->error > max_error)
+      continue;
+    l.position = p->x;
+    l.triangulated = true;
+    l.parallax_deg = parallax;
+  }
+}
+
+void PoseEstimator::forgetOldLandmarks() {
+  if (landmarks_.size() <= params_.max_landmarks) return;
+  std::vector<std::pair<double, std::uint64_t>> by_age;
+  for (const auto& [id, l] : landmarks_)
+    if (!l.fixed) by_age.emplace_back(l.last_seen, id);
+  std::sort(by_age.begin(), by_age.end());
+  const size_t keep = params_.max_landmarks * 9 / 10;
+  for (size_t k = 0; k < by_age.size() && landmarks_.size() > keep; ++k)
+    landmarks_.erase(by_age[k].second);
+}
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,141 @@
+#include "mono_plane_detection/planes/coplanar_groups.h"
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <unordered_set>
+
+#include "mono_plane_detection/planes/cross_ratio.h"
+
+namespace mono_plane_detection {
+namespace {
+
+std::array<cv::Point2d, 5> pick(const PointGroup& g, const std::vector<cv::Point2d>& p) {
+  return {p[g[0]], p[g[1]], p[g[2]], p[g[3]], p[g[4]]};
+}
+
+// Hash of a group's sorted indices, for skipping groups drawn again.
+struct GroupHash {
+  size_t operator()(const PointGroup& g) const {
+    size_t h = 0;
+    for (int i : g) h = h * 1000003u + static_cast<size_t>(i);
+    return h;
+  }
+};
+
+}  // namespace
+
+cv::Mat distanceRows(const std::vector<cv::Point2d>& points, const std::vector<int>& seeds) {
+  cv::Mat rows(static_cast<int>(seeds.size()), static_cast<int>(points.size()), CV_64F);
+  for (size_t s = 0; s < seeds.size(); ++s) {
+    double* row = rows.ptr<double>(static_cast<int>(s));
+    const cv::Point2d& a = points[seeds[s]];
+    for (size_t j = 0; j < points.size(); ++j) {
+      const double dx = points[j].x - a.x, dy = points[j].y - a.y;
+      row[j] = std::sqrt(dx * dx + dy * dy);
+    }
+  }
+  return rows;
+}
+
+GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupParams& params)
+    : points_(points), params_(params), rng_(params.seed) {
+  if (points.size() < 5) return;
+  seeds_.resize(points.size());
+  std::iota(seeds_.begin(), seeds_.end(), 0);
+  std::shuffle(seeds_.begin(), seeds_.end(), rng_);
+  seeds_.resize(std::min(seeds_.size(), static_cast<size_t>(std::max(1, params.max_seeds))));
+  near_.resize(seeds_.size());
+}
+
+std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
+  std::vector<int>& near = near_[slot];
+  if (!near.empty()) return near;
+  const int n = static_cast<int>(points_.size());
+  const size_t k = static_cast<size_t>(std::min(std::max(params_.neighbours, 4), n - 1));
+  const int seed = seeds_[slot];
+  const cv::Point2d& a = points_[seed];
+  // One scan of the seed's row of the distance matrix (squared: same order), keeping
+  // the k nearest at the floor distance or more in a short sorted list.
+  auto nearest = [&](double floor2) {
+    std::vector<std::pair<double, int>> best;
+    best.reserve(k + 1);
+    for (int j = 0; j < n; ++j) {
+      const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
+      const double d2 = dx * dx + dy * dy;
+      if (j == seed || d2 < floor2 || (best.size() == k && d2 >= best.back().first)) continue;
+      best.insert(std::upper_bound(best.begin(), best.end(), std::make_pair(d2, j)), {d2, j});
+      if (best.size() > k) best.pop_back();
+    }
+    return best;
+  };
+  const double min_distance = params_.min_neighbour_distance_px;
+  std::vector<std::pair<double, int>> best = nearest(min_distance * min_distance);
+  if (best.size() < 4) best = nearest(-1.0);
+  for (const auto& b : best) near.push_back(b.second);
+  return near;
+}
+
+bool GroupSampler::next(PointGroup& group) {
+  if (seeds_.empty()) return false;
+  // Round-robin over the seeds; a run of degenerate draws this long means the points
+  // are (nearly) all collinear, and drawing on would never end.
+  const long give_up = 4L * static_cast<long>(seeds_.size()) + 64;
+  while (failures_in_a_row_ < give_up) {
+    const size_t slot = static_cast<size_t>(draws_++ % static_cast<long>(seeds_.size()));
+    // Shuffled in place: any order of the list is as good for the next draw.
+    std::vector<int>& candidates = neighboursOf(slot);
+    for (int k = 0; k < 4; ++k) {  // partial Fisher-Yates: 4 distinct neighbours
+      std::uniform_int_distribution<int> pick_one(k, static_cast<int>(candidates.size()) - 1);
+      std::swap(candidates[k], candidates[pick_one(rng_)]);
+    }
+    group = {seeds_[slot], candidates[0], candidates[1], candidates[2], candidates[3]};
+    if (wellSpread(pick(group, points_), params_.min_shape)) {
+      failures_in_a_row_ = 0;
+      return true;
+    }
+    ++failures_in_a_row_;
+  }
+  return false;
+}
+
+std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
+                                    const GroupParams& params, int count) {
+  std::vector<PointGroup> groups;
+  GroupSampler sampler(points, params);
+  for (PointGroup g; static_cast<int>(groups.size()) < count && sampler.next(g);)
+    groups.push_back(g);
+  return groups;
+}
+
+CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
+                                  const std::vector<cv::Point2d>& view2,
+                                  const GroupParams& params) {
+  CoplanarGroups out;
+  const long wanted =
+      std::min<long>(params.max_groups, static_cast<long>(params.groups_per_point) * view2.size());
+  const long max_tries =
+      std::min<long>(params.max_tries, static_cast<long>(params.tries_per_point) * view2.size());
+  GroupSampler sampler(view2, params);
+  std::unordered_set<PointGroup, GroupHash> seen;
+  seen.reserve(static_cast<size_t>(max_tries));
+  PointGroup g;
+  while (static_cast<long>(out.groups.size()) < wanted && out.tried < max_tries &&
+         sampler.next(g)) {
+    ++out.tried;
+    PointGroup key = g;
+    std::sort(key.begin(), key.end());
+    if (!seen.insert(key).second) continue;
+    if (isCoplanarGroup(g, view1, view2, params)) out.groups.push_back(g);
+  }
+  return out;
+}
+
+bool isCoplanarGroup(const PointGroup& group, const std::vector<cv::Point2d>& view1,
+                     const std::vector<cv::Point2d>& view2, const GroupParams& params) {
+  const auto a = fivePointInvariants(pick(group, view1), params.min_shape);
+  const auto b = fivePointInvariants(pick(group, view2), params.min_shape);
+  return a && b && invariantDistance(*a, *b) <= params.invariant_threshold;
+}
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,315 @@
+#include "mono_plane_detection/tracking/feature_tracker.h"
+
+#include <algorithm>
+#include <limits>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <stdexcept>
+
+#include "mono_plane_detection/geometry/stats.h"
+
+namespace mono_plane_detection {
+namespace {
+
+// Sub-pixel corner refinement, for new corners and re-anchored live ones alike.
+const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+
+bool inside(const cv::Point2f& p, const cv::Size& size) {
+  return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
+}
+
+std::vector<cv::Point2f> positions(const std::vector<TrackedPoint>& points) {
+  std::vector<cv::Point2f> uv;
+  uv.reserve(points.size());
+  for (const auto& p : points) uv.push_back(p.uv);
+  return uv;
+}
+
+// ORB descriptors at given positions; a point too close to the border for ORB's patch
+// gets an empty descriptor.
+std::vector<cv::Mat> orbDescriptors(const cv::Mat& gray, const std::vector<cv::Point2f>& uv) {
+  static thread_local cv::Ptr<cv::ORB> orb = cv::ORB::create(500, 1.2f, /*nlevels=*/1);
+  std::vector<cv::KeyPoint> keypoints;
+  for (size_t i = 0; i < uv.size(); ++i) {
+    keypoints.emplace_back(uv[i], 31.f, 0.f, 0.f, 0, static_cast<int>(i));
+  }
+  cv::Mat rows;
+  orb->compute(gray, keypoints, rows);
+  std::vector<cv::Mat> out(uv.size());
+  for (size_t k = 0; k < keypoints.size(); ++k) {
+    out[keypoints[k].class_id] = rows.row(static_cast<int>(k)).clone();
+  }
+  return out;
+}
+
+}  // namespace
+
+FeatureTracker::FeatureTracker(const TrackerParams& params) : params_(params) {}
+
+void FeatureTracker::reset() {
+  previous_.clear();
+  current_.clear();
+  previous_pyramid_.clear();
+  descriptors_.clear();
+  lost_.clear();
+  stats_ = TrackerFrameStats();
+  image_size_ = cv::Size();
+  found_at_last_search_ = 0;
+  frames_since_search_ = 0;
+}
+
+const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    throw std::invalid_argument("FeatureTracker::process needs a non-empty CV_8UC1 image");
+  }
+  if (gray.size() != image_size_) reset();
+  image_size_ = gray.size();
+  stats_ = TrackerFrameStats();
+
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  std::vector<cv::Mat> pyramid;
+  cv::buildOpticalFlowPyramid(gray, pyramid, window, std::max(0, params_.pyramid_levels - 1));
+
+  previous_ = std::move(current_);
+  current_.clear();
+  trackFromPrevious(pyramid, gray.size());
+  ++frames_since_search_;
+
+  // Paper II-D: the search runs on this image, before the next one is loaded, so the
+  // points still tracked here continue into the new set.
+  if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()), frames_since_search_,
+                   params_)) {
+    search(gray);
+  }
+  previous_pyramid_ = std::move(pyramid);
+  ++frame_count_;
+  return current_;
+}
+
+std::vector<std::uint64_t> FeatureTracker::addPoints(const std::vector<cv::Point2f>& uv,
+                                                     bool target_corner) {
+  std::vector<std::uint64_t> ids;
+  for (const auto& p : uv) {
+    if (!inside(p, image_size_)) continue;
+    TrackedPoint point;
+    point.id = next_id_++;
+    point.uv = p;
+    point.is_new = true;
+    point.is_target_corner = target_corner;
+    current_.push_back(point);
+    ids.push_back(point.id);
+    ++stats_.added;
+  }
+  return ids;
+}
+
+void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
+  if (previous_.empty() || previous_pyramid_.empty()) return;
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  const int max_level = std::max(0, params_.pyramid_levels - 1);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params_.max_iterations, params_.epsilon_px);
+  const std::vector<cv::Point2f> before = positions(previous_);
+  std::vector<cv::Point2f> after;
+  std::vector<uchar> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(previous_pyramid_, pyramid, before, after, status, error, window,
+                           max_level, criteria, 0, params_.min_eigen_threshold);
+
+  std::vector<uchar> back_status(before.size(), 1);
+  std::vector<cv::Point2f> back;
+  if (params_.forward_backward_check) {
+    back = after;
+    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid_, after, back, back_status, error, window,
+                             max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                             params_.min_eigen_threshold);
+    back_status.resize(before.size(), 0);
+  }
+
+  const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
+  for (size_t i = 0; i < previous_.size(); ++i) {
+    bool ok = status[i] && inside(after[i], size);
+    if (ok && params_.forward_backward_check) {
+      const cv::Point2f d = back[i] - before[i];
+      ok = back_status[i] && d.dot(d) <= fb_max2;
+    }
+    if (!ok) {
+      rememberLost(previous_[i]);
+      ++stats_.lost;
+      continue;
+    }
+    TrackedPoint p = previous_[i];
+    p.uv = after[i];
+    p.is_new = false;
+    p.is_tracked = true;
+    p.is_reidentified = false;  // (is_target_corner stays: it is the same point)
+    p.prev_index = static_cast<int>(i);
+    ++p.age;
+    current_.push_back(p);
+  }
+  stats_.tracked = static_cast<int>(current_.size());
+  moveLostWithImage();
+}
+
+// A lost point is out of view or occluded, so nothing tracks it; the median image
+// motion of the live points is the best guess of where it went (it follows camera
+// rotation, the paper's case of points leaving and coming back).
+void FeatureTracker::moveLostWithImage() {
+  if (lost_.empty() || current_.empty()) return;
+  std::vector<float> dx, dy;
+  for (const auto& p : current_) {
+    const cv::Point2f d = p.uv - previous_[p.prev_index].uv;
+    dx.push_back(d.x);
+    dy.push_back(d.y);
+  }
+  const cv::Point2f motion(median(std::move(dx)), median(std::move(dy)));
+  for (auto& l : lost_) l.uv += motion;
+}
+
+cv::Mat FeatureTracker::searchMask(const cv::Size& size) const {
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
+  const int radius = static_cast<int>(std::ceil(params_.min_distance_px));
+  for (const auto& p : current_) cv::circle(mask, p.uv, radius, cv::Scalar(0), cv::FILLED);
+  return mask;
+}
+
+void FeatureTracker::search(const cv::Mat& gray) {
+  stats_.searched = true;
+  if (params_.reanchor_on_search) reanchor(gray);
+  std::vector<cv::Point2f> corners;
+  const int wanted = params_.mask_existing
+                         ? params_.max_features - static_cast<int>(current_.size())
+                         : params_.max_features;
+  if (wanted > 0) {
+    const cv::Mat mask = params_.mask_existing ? searchMask(gray.size()) : cv::Mat();
+    cv::goodFeaturesToTrack(gray, corners, wanted, params_.quality_level, params_.min_distance_px,
+                            mask, params_.block_size);
+  }
+  if (!corners.empty()) {
+    cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
+    // Refinement can push a border corner just outside the image.
+    corners.erase(std::remove_if(corners.begin(), corners.end(),
+                                 [&](const cv::Point2f& c) { return !inside(c, gray.size()); }),
+                  corners.end());
+  }
+
+  // Matched corners are the same physical point as a live one: the live point keeps
+  // its id and its sub-pixel tracked position.
+  const std::vector<int> match =
+      matchCornersToPoints(corners, positions(current_), params_.match_radius_px);
+  std::vector<TrackedPoint> fresh;
+  for (size_t c = 0; c < corners.size(); ++c) {
+    if (match[c] >= 0) {
+      ++stats_.matched;
+      continue;
+    }
+    if (static_cast<int>(current_.size() + fresh.size()) >= params_.max_features) break;
+    TrackedPoint p;
+    p.uv = corners[c];
+    p.is_new = true;
+    fresh.push_back(p);
+  }
+
+  if (params_.reidentify) reidentify(gray, fresh);
+  for (auto& p : fresh) {
+    if (!p.is_reidentified) {
+      p.id = next_id_++;
+      ++stats_.added;
+    }
+    current_.push_back(p);
+  }
+  if (params_.reidentify) refreshDescriptors(gray);
+  found_at_last_search_ = static_cast<int>(current_.size());
+  frames_since_search_ = 0;
+}
+
+// Lucas-Kanade with a translation-only window follows the centroid of the window's
+// gradients, not the corner itself: under image rotation or scale this drifts a few
+// hundredths of a pixel per image and accumulates. Pulling live points back onto their
+// corner at each search bounds the drift to the images between searches.
+void FeatureTracker::reanchor(const cv::Mat& gray) {
+  if (current_.empty()) return;
+  std::vector<cv::Point2f> refined = positions(current_);
+  const int half = params_.reanchor_window_px;
+  cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1), kSubPixCriteria);
+  const double max_shift2 = params_.reanchor_max_shift_px * params_.reanchor_max_shift_px;
+  for (size_t i = 0; i < current_.size(); ++i) {
+    const cv::Point2f d = refined[i] - current_[i].uv;
+    if (d.dot(d) <= max_shift2 && inside(refined[i], gray.size())) current_[i].uv = refined[i];
+  }
+}
+
+void FeatureTracker::rememberLost(const TrackedPoint& point) {
+  if (!params_.reidentify) return;
+  auto it = descriptors_.find(point.id);
+  if (it == descriptors_.end() || it->second.empty()) return;
+  lost_.push_back({point.id, point.uv, point.age, frame_count_, it->second});
+  descriptors_.erase(it);
+}
+
+void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& fresh) {
+  lost_.erase(std::remove_if(lost_.begin(), lost_.end(),
+                             [this](const LostPoint& l) {
+                               return frame_count_ - l.lost_at_frame > params_.reid_memory_frames;
+                             }),
+              lost_.end());
+  if (lost_.empty() || fresh.empty()) return;
+
+  const std::vector<cv::Mat> descriptors = orbDescriptors(gray, positions(fresh));
+  // Each fresh corner claims its best lost point; paper II-D's rule settles conflicts.
+  std::vector<int> claim(fresh.size(), -1);
+  std::vector<double> claim_distance(fresh.size(), 0.0);
+  const double radius2 = params_.reid_max_radius_px * params_.reid_max_radius_px;
+  for (size_t f = 0; f < fresh.size(); ++f) {
+    if (descriptors[f].empty()) continue;
+    int best = -1;
+    int best_d = std::numeric_limits<int>::max();
+    int second_d = std::numeric_limits<int>::max();
+    for (size_t l = 0; l < lost_.size(); ++l) {
+      const cv::Point2f d = fresh[f].uv - lost_[l].uv;
+      if (d.dot(d) > radius2) continue;
+      const int h =
+          static_cast<int>(cv::norm(descriptors[f], lost_[l].descriptor, cv::NORM_HAMMING));
+      if (h < best_d) {
+        second_d = best_d;
+        best_d = h;
+        best = static_cast<int>(l);
+      } else if (h < second_d) {
+        second_d = h;
+      }
+    }
+    const bool distinct =
+        second_d == std::numeric_limits<int>::max() || best_d < params_.reid_ratio * second_d;
+    if (best >= 0 && best_d <= params_.reid_max_hamming && distinct) {
+      claim[f] = best;
+      claim_distance[f] = best_d;
+    }
+  }
+  const std::vector<int> granted = closestClaimWins(claim, claim_distance, lost_.size());
+  std::vector<bool> taken(lost_.size(), false);
+  for (size_t f = 0; f < fresh.size(); ++f) {
+    if (granted[f] < 0) continue;
+    const LostPoint& l = lost_[granted[f]];
+    fresh[f].id = l.id;
+    fresh[f].age = l.age;
+    fresh[f].is_reidentified = true;
+    ++stats_.reidentified;
+    taken[granted[f]] = true;
+  }
+  std::vector<LostPoint> kept;
+  for (size_t l = 0; l < lost_.size(); ++l) {
+    if (!taken[l]) kept.push_back(std::move(lost_[l]));
+  }
+  lost_ = std::move(kept);
+}
+
+void FeatureTracker::refreshDescriptors(const cv::Mat& gray) {
+  const std::vector<cv::Mat> descriptors = orbDescriptors(gray, positions(current_));
+  descriptors_.clear();
+  for (size_t i = 0; i < current_.size(); ++i) {
+    if (!descriptors[i].empty()) descriptors_[current_[i].id] = descriptors[i];
+  }
+}
+
+}  // namespace mono_plane_detection

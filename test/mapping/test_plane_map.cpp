@@ -1,0 +1,122 @@
+// The map of planes: association, stable ids, merging, fading, bounds.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "mono_plane_detection/geometry/plane_fit.h"
+#include "mono_plane_detection/mapping/plane_map.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+// An observation of plane n . x = d: `count` points with ids from first_id, noise 1 cm.
+PlaneObservation observe(const cv::Vec3d& n, double d, std::uint64_t first_id, int count,
+                         unsigned seed, double extent = 1.0) {
+  cv::Vec3d u, v;
+  planeAxes(n, u, v);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> spread(-extent, extent);
+  std::normal_distribution<double> noise(0, 0.01);
+  PlaneObservation obs;
+  obs.viewpoint = (d + 2) * n;  // on the normal's side
+  for (int i = 0; i < count; ++i) {
+    obs.ids.push_back(first_id + i);
+    obs.points.push_back(d * n + spread(rng) * u + spread(rng) * v + noise(rng) * n);
+  }
+  return obs;
+}
+
+const cv::Vec3d kFloor(0, 1, 0), kWall(0, 0, 1);
+
+}  // namespace
+
+TEST(PlaneMap, TwoPlanesKeepTheirIdsOverTime) {
+  PlaneMap map;
+  for (int k = 0; k < 10; ++k) {
+    const auto ids = map.update(
+        {observe(kWall, 0.0, 100 + k * 3, 20, k), observe(kFloor, -0.8, 500 + k * 3, 15, 50 + k)},
+        1000 + 0.1 * k);
+    ASSERT_EQ(ids.size(), 2u);
+    EXPECT_EQ(ids[0], 1);
+    EXPECT_EQ(ids[1], 2);
+  }
+  ASSERT_EQ(map.planes().size(), 2u);
+  const MapPlane& wall = map.planes()[0];
+  EXPECT_LT(normalAngleDeg(wall.normal, kWall), 1.0);
+  EXPECT_NEAR(wall.distance, 0.0, 0.01);
+  EXPECT_EQ(wall.observations, 10);
+  EXPECT_TRUE(wall.confirmed(map.params()));
+  EXPECT_GE(wall.polygon.size(), 3u);
+  EXPECT_NEAR(map.planes()[1].distance, -0.8, 0.01);
+}
+
+TEST(PlaneMap, ObservationsOfTheSamePlaneWithNewTracksAssociateByGeometry) {
+  PlaneMap map;
+  map.update({observe(kWall, 0.0, 100, 20, 1)}, 1000);
+  const auto ids = map.update({observe(kWall, 0.03, 900, 20, 2)}, 1000.1);  // 3 cm off, new ids
+  EXPECT_EQ(ids[0], 1);
+  EXPECT_EQ(map.planes().size(), 1u);
+  // 0.5 m away it is another (parallel) plane.
+  const auto other = map.update({observe(kWall, 0.5, 2000, 20, 3)}, 1000.2);
+  EXPECT_EQ(other[0], 2);
+}
+
+TEST(PlaneMap, TooFewOrScatteredPointsAreRejected) {
+  PlaneMap map;
+  EXPECT_EQ(map.update({observe(kWall, 0.0, 100, 4, 1)}, 1000)[0], -1);
+  PlaneObservation cloud;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 30; ++i) {
+    cloud.ids.push_back(i);
+    cloud.points.push_back({u(rng), u(rng), u(rng)});
+  }
+  EXPECT_EQ(map.update({cloud}, 1000.1)[0], -1);
+  EXPECT_TRUE(map.planes().empty());
+}
+
+TEST(PlaneMap, DuplicatesMergeIntoTheOlderId) {
+  MapParams params;
+  params.min_shared_ids = 2.0;  // never associate by shared tracks here
+  params.max_offset_m = 0.05;   // the two start apart (8 cm)
+  PlaneMap map(params);
+  map.update({observe(kWall, 0.0, 100, 20, 1)}, 1000);
+  map.update({observe(kWall, 0.08, 300, 20, 2)}, 1000);
+  ASSERT_EQ(map.planes().size(), 2u);
+  // Later points show both are one plane at 4 cm: the refit lands between, they merge.
+  for (int k = 0; k < 4; ++k) map.update({observe(kWall, 0.04, 100, 20, 10 + k)}, 1000.1 * k);
+  map.update({observe(kWall, 0.04, 300, 20, 20)}, 1001);
+  ASSERT_EQ(map.planes().size(), 1u);
+  EXPECT_EQ(map.planes()[0].id, 1);
+}
+
+TEST(PlaneMap, UnconfirmedPlanesVanishConfirmedOnesFade) {
+  PlaneMap map;
+  for (int k = 0; k < 3; ++k) map.update({observe(kWall, 0.0, 100, 20, k)}, 1000 + 0.1 * k);
+  map.update({observe(kFloor, -0.8, 500, 20, 9)}, 1000.3);  // seen once
+  ASSERT_EQ(map.planes().size(), 2u);
+  const double fresh = map.planes()[0].confidence;
+  map.update({}, 1003.0);  // 2.7 s later: the floor was never confirmed
+  ASSERT_EQ(map.planes().size(), 1u);
+  EXPECT_EQ(map.planes()[0].id, 1);
+  map.update({}, 1000.2 + map.params().fade_time_s);
+  EXPECT_NEAR(map.planes()[0].confidence, fresh * std::exp(-1.0), 0.02);
+}
+
+TEST(PlaneMap, MemoryIsBounded) {
+  MapParams params;
+  params.max_planes = 3;
+  params.max_points_per_plane = 50;
+  params.confirm_observations = 1;
+  PlaneMap map(params);
+  for (int k = 0; k < 8; ++k)  // 8 parallel planes 1 m apart
+    map.update({observe(kWall, double(k), 1000 * (k + 1), 20, k)}, 1000 + k);
+  EXPECT_EQ(map.planes().size(), 3u);
+  for (int k = 0; k < 10; ++k)
+    map.update({observe(kFloor, -0.8, 50000 + 30 * k, 30, 100 + k)}, 1010);
+  for (const MapPlane& p : map.planes()) EXPECT_LE(p.points.size(), 50u);
+  map.reset();
+  EXPECT_TRUE(map.planes().empty());
+  EXPECT_EQ(map.update({observe(kWall, 0, 1, 20, 1)}, 2000)[0], 1);  // ids start over
+}

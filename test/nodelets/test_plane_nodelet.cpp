@@ -1,0 +1,385 @@
+// Drives PlaneNodelet with Tracks of a known room and motion, and with bad input;
+// checks planes, markers, map points, tf and the debug image.
+#include <cv_bridge/cv_bridge.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <limits>
+#include <map>
+
+#include "mono_plane_detection/PlaneArray.h"
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/geometry/plane_fit.h"
+#include "mono_plane_detection/ros/pose_msg.h"
+#include "support/synthetic_tracks.h"
+#include "support/test_timeouts.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+TracksPtr toTracks(const TrackFrame& f) {
+  TracksPtr msg(new Tracks);
+  msg->header.stamp = ros::Time(f.stamp);
+  msg->header.frame_id = "camera_optical";
+  msg->width = static_cast<uint32_t>(f.size.width);
+  msg->height = static_cast<uint32_t>(f.size.height);
+  for (size_t i = 0; i < f.ids.size(); ++i) {
+    msg->id.push_back(f.ids[i]);
+    msg->u.push_back(static_cast<float>(f.pixels[i].x));
+    msg->v.push_back(static_cast<float>(f.pixels[i].y));
+    msg->prev_index.push_back(-1);
+    msg->flags.push_back(Tracks::FLAG_TRACKED |
+                         (f.target_corner[i] ? Tracks::FLAG_TARGET_CORNER : 0));
+    msg->age.push_back(0);
+  }
+  return msg;
+}
+
+sensor_msgs::CameraInfo cameraInfo(const CameraModel& camera) {
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = "camera_optical";
+  info.width = static_cast<uint32_t>(camera.size.width);
+  info.height = static_cast<uint32_t>(camera.size.height);
+  info.distortion_model = "plumb_bob";
+  info.D = {camera.k1, camera.k2, 0, 0, 0};
+  const cv::Matx33d K = camera.K();
+  for (int i = 0; i < 9; ++i) info.K[i] = K.val[i];
+  return info;
+}
+
+class PlaneNodeletTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { world_ = new SyntheticTracks("wheeled"); }
+  static void TearDownTestSuite() { delete world_; }
+
+  void SetUp() override {
+    tracks_pub_ = nh_.advertise<Tracks>("tracks", 20);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 2, true);
+    image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 20);
+    planes_sub_ = nh_.subscribe("planes", 50, &PlaneNodeletTest::onPlanes, this);
+    no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
+    // Both nodelets live in one manager process: one connection.
+    spinUntil(
+        [&] {
+          return tracks_pub_.getNumSubscribers() > 0 && planes_sub_.getNumPublishers() > 0 &&
+                 no_info_sub_.getNumPublishers() > 0;
+        },
+        20.0);
+    ASSERT_GT(tracks_pub_.getNumSubscribers(), 0u) << "plane nodelets never subscribed";
+  }
+
+  void onPlanes(const PlaneArrayConstPtr& msg) { planes_[msg->header.stamp.toNSec()] = msg; }
+  void onNoInfo(const PlaneArrayConstPtr& msg) { no_info_[msg->header.stamp.toNSec()] = msg; }
+
+  template <typename T>
+  T waitFor(const std::map<uint64_t, T>& store, uint64_t key, double timeout = 10.0) {
+    if (!spinUntil([&] { return store.count(key) > 0; }, timeout)) return nullptr;
+    return store.at(key);
+  }
+
+  // Publishes and waits for the planes of this stamp; null when none came.
+  PlaneArrayConstPtr send(const TracksPtr& msg, double timeout = 10.0) {
+    tracks_pub_.publish(msg);
+    return waitFor(planes_, msg->header.stamp.toNSec(), timeout);
+  }
+
+  // The room from t0 for `frames` images at 30 Hz, stamps shifted by `offset`.
+  PlaneArrayConstPtr drive(double t0, int frames, double offset) {
+    PlaneArrayConstPtr last;
+    for (int k = 0; k < frames; ++k) {
+      TrackFrame f = world_->frame(t0 + k / 30.0);
+      f.stamp += offset;
+      last = send(toTracks(f));
+      if (!last) return nullptr;
+    }
+    return last;
+  }
+
+  static SyntheticTracks* world_;
+  ros::NodeHandle nh_;
+  ros::Publisher tracks_pub_, info_pub_, image_pub_;
+  ros::Subscriber planes_sub_, no_info_sub_;
+  std::map<uint64_t, PlaneArrayConstPtr> planes_, no_info_;
+  visualization_msgs::MarkerArrayConstPtr markers_;
+  sensor_msgs::PointCloud2ConstPtr cloud_;
+};
+
+SyntheticTracks* PlaneNodeletTest::world_ = nullptr;
+
+// Runs first: the nodelet has no camera_info yet.
+TEST_F(PlaneNodeletTest, A_ImageSpacePlanesUntilCameraInfo) {
+  const PlaneArrayConstPtr last = drive(0, 10, 0);
+  ASSERT_TRUE(last);
+  EXPECT_FALSE(last->metric);
+  EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
+  ASSERT_FALSE(last->planes.empty());
+  EXPECT_FALSE(last->planes[0].metric);
+  EXPECT_TRUE(last->planes[0].observed);
+  EXPECT_GE(last->planes[0].inlier_ids.size(), 8u);
+  EXPECT_NE(last->planes[0].homography[8], 0.0);
+  EXPECT_GT(last->reference_stamp, 0);
+}
+
+TEST_F(PlaneNodeletTest, B_ZeroIntrinsicsAreRejected) {
+  sensor_msgs::CameraInfo zero = cameraInfo(world_->camera);
+  zero.K.fill(0.0);
+  info_pub_.publish(zero);
+  scaledWait(0.5).sleep();
+  const PlaneArrayConstPtr last = drive(0, 3, 100);  // 100 s later: a pause, not a problem
+  ASSERT_TRUE(last);
+  EXPECT_FALSE(last->metric);
+  EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
+  sensor_msgs::CameraInfo nan = cameraInfo(world_->camera);
+  nan.K[2] = std::numeric_limits<double>::quiet_NaN();
+  info_pub_.publish(nan);
+  scaledWait(0.5).sleep();
+  const PlaneArrayConstPtr after_nan = drive(3 / 30.0, 3, 100);
+  ASSERT_TRUE(after_nan);
+  EXPECT_EQ(after_nan->status, "no camera intrinsics: image-space planes only");
+}
+
+TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
+  info_pub_.publish(cameraInfo(world_->camera));
+  scaledWait(0.5).sleep();
+  ros::Subscriber markers = nh_.subscribe<visualization_msgs::MarkerArray>(
+      "plane_markers", 10,
+      [this](const visualization_msgs::MarkerArrayConstPtr& m) { markers_ = m; });
+  ros::Subscriber cloud = nh_.subscribe<sensor_msgs::PointCloud2>(
+      "map_points", 10, [this](const sensor_msgs::PointCloud2ConstPtr& c) { cloud_ = c; });
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  const PlaneArrayConstPtr last = drive(0, 240, 200);
+  ASSERT_TRUE(last);
+  EXPECT_TRUE(last->metric);
+  EXPECT_EQ(last->header.frame_id, "map");
+  EXPECT_EQ(last->status.rfind("tracking", 0), 0u) << last->status;
+  // The front wall (the target's, map z = 0) and the floor (0.8 m below the target).
+  bool wall = false, floor = false;
+  for (const auto& p : last->planes) {
+    if (!p.metric || p.observations < 3) continue;
+    const cv::Vec3d n(p.normal.x, p.normal.y, p.normal.z);
+    wall |= normalAngleDeg(n, {0, 0, 1}) < 5 && std::abs(p.distance) < 0.1;
+    floor |= normalAngleDeg(n, {0, 1, 0}) < 5 && std::abs(p.distance + 0.8) < 0.1;
+    EXPECT_GE(p.polygon.size(), 3u);
+    EXPECT_GT(p.confidence, 0.0);
+  }
+  EXPECT_TRUE(wall);
+  EXPECT_TRUE(floor);
+  if (!wall || !floor)
+    for (const auto& p : last->planes)
+      std::printf("plane %d: n (%.2f %.2f %.2f) d %.2f, %u obs\n", p.id, p.normal.x, p.normal.y,
+                  p.normal.z, p.distance, p.observations);
+  // The camera pose in the message against the truth.
+  const Pose truth = world_->truthMapFromCamera(239 / 30.0);
+  EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
+  // Markers, map points and tf were published.
+  const ros::WallTime deadline = ros::WallTime::now() + scaledWait(3.0);
+  while ((!markers_ || !cloud_) && ros::WallTime::now() < deadline) {
+    drive(240 / 30.0, 1, 200);
+    ros::spinOnce();
+  }
+  ASSERT_TRUE(markers_);
+  ASSERT_TRUE(cloud_);
+  EXPECT_GT(cloud_->width, 50u);
+  int polygons = 0;
+  for (const auto& m : markers_->markers)
+    polygons += m.ns == "planes" && m.action == visualization_msgs::Marker::ADD;
+  EXPECT_GE(polygons, 2);
+  EXPECT_TRUE(buffer.canTransform("map", "camera_optical", ros::Time(0),
+                                  ros::Duration(2.0 * timeoutScale())));
+}
+
+TEST_F(PlaneNodeletTest, D_BadTracksAreDroppedAndTheMapSurvives) {
+  TrackFrame good = world_->frame(241 / 30.0);
+  good.stamp += 200;
+  auto bad = [&](auto change) {
+    TracksPtr msg = toTracks(good);
+    msg->header.stamp += ros::Duration(0.001);  // a stamp of its own
+    change(*msg);
+    EXPECT_FALSE(send(msg, 1.0)) << "a malformed message got an answer";
+  };
+  bad([](Tracks& m) { m.u.pop_back(); });
+  bad([](Tracks& m) { m.flags.clear(); });
+  bad([](Tracks& m) { m.v[3] = std::numeric_limits<float>::quiet_NaN(); });
+  bad([](Tracks& m) { m.u[2] = std::numeric_limits<float>::infinity(); });
+  bad([](Tracks& m) { m.id[1] = m.id[0]; });
+  bad([](Tracks& m) { m.u[0] = 5000; });
+  bad([](Tracks& m) { m.width = 0; });
+  // Still alive, the map intact.
+  const PlaneArrayConstPtr after = send(toTracks(good));
+  ASSERT_TRUE(after);
+  EXPECT_TRUE(after->metric);
+  EXPECT_GE(after->planes.size(), 2u);
+}
+
+TEST_F(PlaneNodeletTest, E_FewOrVeryManyPointsAreAnswered) {
+  double stamp = 1000 + 200 + 242 / 30.0;
+  for (int n = 0; n <= 4; ++n) {
+    TrackFrame f;
+    f.stamp = stamp += 0.033;
+    f.size = world_->camera.size;
+    for (int i = 0; i < n; ++i) {
+      f.ids.push_back(900000 + i);
+      f.pixels.emplace_back(100 + 50 * i, 200);
+      f.target_corner.push_back(false);
+    }
+    const PlaneArrayConstPtr r = send(toTracks(f));
+    ASSERT_TRUE(r) << n << " points";
+    for (const auto& p : r->planes) EXPECT_FALSE(p.observed);
+  }
+  // 10 000 points: groups are capped, so the answer comes in bounded time.
+  TrackFrame many;
+  many.size = world_->camera.size;
+  cv::RNG rng(3);
+  for (int i = 0; i < 10000; ++i) {
+    many.ids.push_back(2000000 + i);
+    many.pixels.emplace_back(rng.uniform(0.0, 639.0), rng.uniform(0.0, 479.0));
+    many.target_corner.push_back(false);
+  }
+  // Enough images for the frame_gap reference to hold the same 10 000 ids (moving 1 px).
+  double slowest = 0;
+  size_t observed = 0;
+  for (int k = 0; k < 8; ++k) {
+    many.stamp = stamp += 0.033;
+    for (auto& p : many.pixels) p.x = std::min(639.0, p.x + 0.5);
+    const ros::WallTime start = ros::WallTime::now();
+    const PlaneArrayConstPtr r = send(toTracks(many), 60.0);
+    ASSERT_TRUE(r);
+    slowest = std::max(slowest, (ros::WallTime::now() - start).toSec());
+    for (const auto& p : r->planes) observed += p.observed;
+  }
+  EXPECT_GT(observed, 0u);  // the shift is one homography: it was really searched
+  std::printf("10000 points: slowest answer %.0f ms\n", slowest * 1e3);
+}
+
+TEST_F(PlaneNodeletTest, F_TimeGoingBackwardsStartsTheMapOver) {
+  const PlaneArrayConstPtr r = drive(0, 3, 0);  // stamps back at 1000 s: a bag loop
+  ASSERT_TRUE(r);
+  EXPECT_FALSE(r->metric);  // the start needs the target and motion again
+  EXPECT_TRUE(r->planes.empty() || !r->planes[0].metric);
+  const PlaneArrayConstPtr later = drive(3 / 30.0, 60, 0);
+  ASSERT_TRUE(later);
+  EXPECT_TRUE(later->metric);
+}
+
+TEST_F(PlaneNodeletTest, G_DebugImageWhileWatched) {
+  sensor_msgs::ImageConstPtr drawn;
+  ros::Subscriber debug = nh_.subscribe<sensor_msgs::Image>(
+      "debug_image", 2, [&](const sensor_msgs::ImageConstPtr& m) { drawn = m; });
+  spinUntil([&] { return image_pub_.getNumSubscribers() > 0; }, 10.0);
+  ASSERT_GT(image_pub_.getNumSubscribers(), 0u) << "the nodelet did not subscribe to the image";
+  for (int k = 0; k < 20 && !drawn; ++k) {
+    TrackFrame f = world_->frame(2.0 + k / 30.0);
+    const cv::Mat grey(f.size, CV_8UC1, cv::Scalar(100));
+    std_msgs::Header header;
+    header.stamp = ros::Time(f.stamp);
+    header.frame_id = "camera_optical";
+    image_pub_.publish(cv_bridge::CvImage(header, "mono8", grey).toImageMsg());
+    ros::WallDuration(0.05).sleep();
+    send(toTracks(f));
+    ros::WallDuration(0.05).sleep();
+    ros::spinOnce();
+  }
+  ASSERT_TRUE(drawn);
+  EXPECT_EQ(drawn->encoding, "bgr8");
+  EXPECT_EQ(drawn->width, 640u);
+  debug.shutdown();
+}
+
+TEST_F(PlaneNodeletTest, H_WithoutCameraInfoThePlanesStayInTheImage) {
+  const auto key = ros::Time(world_->frame(2.5).stamp).toNSec();
+  tracks_pub_.publish(toTracks(world_->frame(2.5)));
+  const PlaneArrayConstPtr r = waitFor(no_info_, key);
+  ASSERT_TRUE(r);
+  EXPECT_FALSE(r->metric);
+  for (const auto& p : r->planes) EXPECT_FALSE(p.metric);
+}
+
+// The robot's odometry: tf odom -> camera_optical for every image (the true pose seen
+// from an odometry origin 1 m aside and turned). The nodelet must take the pose from it
+// once the start has fixed map -> odom, and publish map -> odom.
+TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
+  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
+      "planes_odom", 50,
+      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  tf2_ros::TransformBroadcaster broadcaster;
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
+  PlaneArrayConstPtr last;
+  for (int k = 0; k < 90; ++k) {
+    const double t = k / 30.0;
+    TrackFrame f = world_->frame(t);
+    f.stamp += 500;  // its own time line
+    const Pose odom = odom_from_map * world_->truthMapFromCamera(t);
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(f.stamp);
+    tf.header.frame_id = "odom";
+    tf.child_frame_id = "camera_optical";
+    tf.transform = toTransformMsg(odom);
+    broadcaster.sendTransform(tf);
+    ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    tracks.publish(toTracks(f));
+    last = waitFor(answers, ros::Time(f.stamp).toNSec());
+    ASSERT_TRUE(last) << "image " << k;
+  }
+  EXPECT_EQ(last->status, "tracking (odometry)");
+  const Pose truth = world_->truthMapFromCamera(89 / 30.0);
+  EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
+  EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
+  EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0),
+                                  ros::Duration(2.0 * timeoutScale())));
+}
+
+// Killing the plane nodelet while tracks keep coming, and loading it again: it answers
+// at once (image-space planes until it has intrinsics and the start) and becomes metric.
+TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
+  nodelet::NodeletUnload unload;
+  unload.request.name = "/plane_detector";
+  ASSERT_TRUE(ros::service::call("/manager/unload_nodelet", unload));
+  ASSERT_TRUE(unload.response.success);
+  // Tracks go on with nobody listening on this instance.
+  for (int k = 0; k < 5; ++k) tracks_pub_.publish(toTracks(world_->frame(k / 30.0)));
+  nodelet::NodeletLoad load;
+  load.request.name = "/plane_detector";
+  load.request.type = "mono_plane_detection/PlaneNodelet";
+  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load));
+  ASSERT_TRUE(load.response.success);
+  info_pub_.publish(cameraInfo(world_->camera));  // latched: the new instance gets it
+  spinUntil([&] { return planes_sub_.getNumPublishers() > 0; }, 10.0);
+  scaledWait(1.0).sleep();
+  const PlaneArrayConstPtr first = drive(0, 1, 800);
+  ASSERT_TRUE(first) << "the reloaded nodelet does not answer";
+  EXPECT_FALSE(first->metric);
+  const PlaneArrayConstPtr later = drive(1 / 30.0, 80, 800);
+  ASSERT_TRUE(later);
+  EXPECT_TRUE(later->metric) << later->status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_plane_nodelet");
+  ros::NodeHandle nh;
+  readTimeoutScale();
+  return RUN_ALL_TESTS();
+}

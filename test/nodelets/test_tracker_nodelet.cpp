@@ -1,0 +1,335 @@
+// Drives TrackerNodelet with images of known motion and bad input; checks `tracks`.
+#include <cv_bridge/cv_bridge.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <set>
+
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/sim/scene_renderer.h"
+#include "mono_plane_detection/sim/synthetic_views.h"
+#include "support/test_timeouts.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+const cv::Size kView(640, 480);
+const cv::Point2d kCentred(-180, -160);
+
+class TrackerNodeletTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 10);
+    tracks_sub_ = nh_.subscribe("tracks", 50, &TrackerNodeletTest::onTracks, this);
+    // The nodelet subscribes lazily: wait until our listener made it subscribe.
+    spinUntil([&] { return image_pub_.getNumSubscribers() > 0; }, 20.0);
+    ASSERT_GT(image_pub_.getNumSubscribers(), 0u) << "tracker never subscribed to image";
+  }
+
+  void onTracks(const TracksConstPtr& msg) { received_[msg->header.stamp.toNSec()] = msg; }
+
+  sensor_msgs::ImagePtr makeImage(const cv::Mat& image, const std::string& encoding, double stamp) {
+    std_msgs::Header header;
+    header.stamp = ros::Time(stamp);
+    header.frame_id = "camera_optical";
+    return cv_bridge::CvImage(header, encoding, image).toImageMsg();
+  }
+
+  // Publishes and waits for the Tracks of this stamp; null when none came.
+  TracksConstPtr send(const sensor_msgs::ImagePtr& msg, double timeout = 5.0) {
+    image_pub_.publish(msg);
+    const auto key = msg->header.stamp.toNSec();
+    if (!spinUntil([&] { return received_.count(key) > 0; }, timeout)) return nullptr;
+    return received_.at(key);
+  }
+
+  cv::Mat view(const cv::Point2d& shift) {
+    static const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
+    return warpView(texture, similarity(0, {}, kCentred + shift), kView);
+  }
+
+  ros::NodeHandle nh_;
+  ros::Publisher image_pub_;
+  ros::Subscriber tracks_sub_;
+  std::map<uint64_t, TracksConstPtr> received_;
+  double stamp_ = 100.0;
+};
+
+TEST_F(TrackerNodeletTest, TracksFollowKnownMotion) {
+  const cv::Point2d step(1.5, -0.5);
+  std::map<uint64_t, cv::Point2d> texture_of;  // id -> shift-free position at birth
+  std::set<uint64_t> first_ids;
+  double error_sum = 0;
+  int error_count = 0;
+  for (int k = 0; k < 20; ++k) {
+    const cv::Point2d shift = k * step;
+    auto tracks = send(makeImage(view(shift), "mono8", stamp_ += 0.1));
+    ASSERT_TRUE(tracks) << "no tracks for frame " << k;
+    EXPECT_EQ(tracks->header.frame_id, "camera_optical");
+    EXPECT_EQ(tracks->width, 640u);
+    EXPECT_EQ(tracks->height, 480u);
+    const size_t n = tracks->id.size();
+    ASSERT_EQ(tracks->u.size(), n);
+    ASSERT_EQ(tracks->v.size(), n);
+    ASSERT_EQ(tracks->flags.size(), n);
+    ASSERT_EQ(tracks->prev_index.size(), n);
+    ASSERT_EQ(tracks->age.size(), n);
+    if (k == 0) {
+      EXPECT_EQ(n, 50u);
+      EXPECT_TRUE(tracks->searched);
+    }
+    for (size_t i = 0; i < n; ++i) {
+      const cv::Point2d uv(tracks->u[i], tracks->v[i]);
+      if (k == 0) first_ids.insert(tracks->id[i]);
+      auto it = texture_of.find(tracks->id[i]);
+      if (it == texture_of.end()) {
+        EXPECT_TRUE(tracks->flags[i] & Tracks::FLAG_NEW);
+        EXPECT_EQ(tracks->prev_index[i], -1);
+        texture_of[tracks->id[i]] = uv - shift;
+        continue;
+      }
+      EXPECT_TRUE(tracks->flags[i] & Tracks::FLAG_TRACKED);
+      EXPECT_GE(tracks->prev_index[i], 0);
+      error_sum += cv::norm(it->second + shift - uv);
+      ++error_count;
+    }
+  }
+  ASSERT_GT(error_count, 500);
+  EXPECT_LT(error_sum / error_count, 0.2);
+  auto last = received_.rbegin()->second;
+  int kept = 0;
+  for (auto id : last->id) kept += first_ids.count(id);
+  EXPECT_GE(kept, 45);
+}
+
+TEST_F(TrackerNodeletTest, AcceptsColourBayerAndSixteenBitImages) {
+  cv::Mat bgr;
+  cv::cvtColor(view({0, 0}), bgr, cv::COLOR_GRAY2BGR);
+  auto tracks = send(makeImage(bgr, "bgr8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  cv::Mat rgba;
+  cv::cvtColor(view({0, 0}), rgba, cv::COLOR_GRAY2RGBA);
+  tracks = send(makeImage(rgba, "rgba8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  cv::Mat wide;
+  view({0, 0}).convertTo(wide, CV_16U, 256.0);
+  tracks = send(makeImage(wide, "mono16", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  tracks = send(makeImage(view({0, 0}), "bayer_rggb8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_GT(tracks->id.size(), 20u);
+}
+
+TEST_F(TrackerNodeletTest, BadImagesAreDroppedAndTrackingGoesOn) {
+  auto good = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(good);
+
+  // Unsupported encoding: dropped, nothing published.
+  cv::Mat floats(480, 640, CV_32FC1, cv::Scalar(0.5));
+  EXPECT_FALSE(send(makeImage(floats, "32FC1", stamp_ += 0.1), 1.0));
+  auto weird = makeImage(view({0, 0}), "mono8", stamp_ += 0.1);
+  weird->encoding = "no_such_encoding";
+  EXPECT_FALSE(send(weird, 1.0));
+
+  // 0x0 image and a buffer shorter than step x height: dropped.
+  auto empty = boost::make_shared<sensor_msgs::Image>();
+  empty->header.stamp = ros::Time(stamp_ += 0.1);
+  empty->encoding = "mono8";
+  EXPECT_FALSE(send(empty, 1.0));
+  auto truncated = makeImage(view({0, 0}), "mono8", stamp_ += 0.1);
+  truncated->data.resize(1000);
+  EXPECT_FALSE(send(truncated, 1.0));
+
+  // A good image after all that: the same points are still tracked.
+  auto after = send(makeImage(view({1, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(after);
+  std::set<uint64_t> before(good->id.begin(), good->id.end());
+  int kept = 0;
+  for (auto id : after->id) kept += before.count(id);
+  EXPECT_GE(kept, 45);
+}
+
+TEST_F(TrackerNodeletTest, BlackTinyAndResizedImages) {
+  auto black = send(makeImage(cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(black);
+  EXPECT_TRUE(black->id.empty());
+
+  auto tiny = send(makeImage(cv::Mat(1, 1, CV_8UC1, cv::Scalar(7)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tiny);
+  EXPECT_TRUE(tiny->id.empty());
+  EXPECT_EQ(tiny->width, 1u);
+
+  cv::Mat small;
+  cv::resize(view({0, 0}), small, {320, 240}, 0, 0, cv::INTER_AREA);
+  auto resized = send(makeImage(small, "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(resized);
+  EXPECT_EQ(resized->width, 320u);
+  ASSERT_FALSE(resized->id.empty());
+  for (auto f : resized->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+}
+
+TEST_F(TrackerNodeletTest, WhiteOddHugeAndBigEndianImages) {
+  // All white and saturated: no corners, an empty answer.
+  auto white = send(makeImage(cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(white);
+  EXPECT_TRUE(white->id.empty());
+  // An odd size.
+  cv::Mat odd;
+  cv::resize(view({0, 0}), odd, {641, 479});
+  auto odd_tracks = send(makeImage(odd, "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(odd_tracks);
+  EXPECT_EQ(odd_tracks->width, 641u);
+  EXPECT_FALSE(odd_tracks->id.empty());
+  // A huge frame is still answered (slowly).
+  cv::Mat huge;
+  cv::resize(view({0, 0}), huge, {4096, 3072}, 0, 0, cv::INTER_LINEAR);
+  const ros::WallTime start = ros::WallTime::now();
+  auto huge_tracks = send(makeImage(huge, "mono8", stamp_ += 0.1), 30.0);
+  ASSERT_TRUE(huge_tracks);
+  EXPECT_EQ(huge_tracks->width, 4096u);
+  EXPECT_FALSE(huge_tracks->id.empty());
+  std::printf("4096x3072: answered in %.0f ms\n", (ros::WallTime::now() - start).toSec() * 1e3);
+  // Big-endian mono16: the bytes of each pixel swapped, the same view.
+  cv::Mat wide;
+  view({0, 0}).convertTo(wide, CV_16U, 256.0);
+  auto big = makeImage(wide, "mono16", stamp_ += 0.1);
+  big->is_bigendian = 1;
+  for (size_t i = 0; i + 1 < big->data.size(); i += 2) std::swap(big->data[i], big->data[i + 1]);
+  auto big_tracks = send(big);
+  ASSERT_TRUE(big_tracks);
+  auto little_tracks = send(makeImage(wide, "mono16", stamp_ += 0.1));
+  ASSERT_TRUE(little_tracks);
+  // Read right, the big-endian image is the same view: its points are tracked on.
+  int tracked = 0;
+  for (auto f : little_tracks->flags) tracked += (f & Tracks::FLAG_TRACKED) != 0;
+  EXPECT_GE(tracked, 45);
+}
+
+TEST_F(TrackerNodeletTest, DuplicateStampsGapsAndEmptyFrameIds) {
+  auto first = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(first);
+  // The same stamp again: dropped.
+  received_.clear();
+  auto again = makeImage(view({0.5, 0}), "mono8", stamp_);
+  EXPECT_FALSE(send(again, 1.0));
+  // After a 2 s pause: tracking starts over (every point new).
+  auto after_gap = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 2.0));
+  ASSERT_TRUE(after_gap);
+  for (auto f : after_gap->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+  // An empty frame_id is passed on (with a warning), tracking goes on.
+  auto unnamed = makeImage(view({1, 0}), "mono8", stamp_ += 0.1);
+  unnamed->header.frame_id.clear();
+  auto tracks = send(unnamed);
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->header.frame_id, "");
+  int tracked = 0;
+  for (auto f : tracks->flags) tracked += (f & Tracks::FLAG_TRACKED) != 0;
+  EXPECT_GE(tracked, 45);
+}
+
+TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
+  ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1)));
+  auto same = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(same);
+  for (auto f : same->flags) EXPECT_TRUE(f & Tracks::FLAG_TRACKED);
+  auto looped = send(makeImage(view({1, 0}), "mono8", stamp_ - 50.0));
+  ASSERT_TRUE(looped);
+  for (auto f : looped->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
+  for (auto p : looped->prev_index) EXPECT_EQ(p, -1);
+}
+
+TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
+  ros::Publisher info_pub = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
+  sensor_msgs::CameraInfo zero;  // all-zero intrinsics
+  zero.width = 640;
+  zero.height = 480;
+  info_pub.publish(zero);
+  scaledWait(0.3).sleep();
+  auto tracks = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_EQ(tracks->id.size(), 50u);
+
+  sensor_msgs::CameraInfo other_size;  // valid, but for another image size
+  other_size.width = 1280;
+  other_size.height = 720;
+  other_size.K = {525, 0, 640, 0, 525, 360, 0, 0, 1};
+  other_size.K[2] = std::nan("");
+  info_pub.publish(other_size);
+  other_size.K[2] = 640;
+  info_pub.publish(other_size);
+  scaledWait(0.3).sleep();
+  tracks = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_GE(tracks->id.size(), 45u);
+}
+
+TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
+  sensor_msgs::ImageConstPtr debug;
+  ros::Subscriber sub = nh_.subscribe<sensor_msgs::Image>(
+      "debug_image", 5, [&](const sensor_msgs::ImageConstPtr& m) { debug = m; });
+  spinUntil([&] { return sub.getNumPublishers() > 0; }, 5.0);
+  ASSERT_GT(sub.getNumPublishers(), 0u);
+  scaledWait(0.3).sleep();  // let the nodelet see its new subscriber
+  const double stamp = stamp_ += 0.1;
+  ASSERT_TRUE(send(makeImage(view({0, 0}), "mono8", stamp)));
+  spinUntil([&] { return debug != nullptr; }, 5.0);
+  ASSERT_TRUE(debug);
+  EXPECT_EQ(debug->encoding, "bgr8");
+  EXPECT_EQ(debug->width, 640u);
+  EXPECT_EQ(debug->height, 480u);
+  EXPECT_DOUBLE_EQ(debug->header.stamp.toSec(), ros::Time(stamp).toSec());
+  // Points are drawn in colour on a grey image: some pixels are not grey.
+  const cv::Mat drawn = cv_bridge::toCvShare(debug)->image;
+  int coloured = 0;
+  for (int y = 0; y < drawn.rows; ++y)
+    for (int x = 0; x < drawn.cols; ++x) {
+      const cv::Vec3b p = drawn.at<cv::Vec3b>(y, x);
+      coloured += (p[0] != p[1] || p[1] != p[2]);
+    }
+  EXPECT_GT(coloured, 500);
+}
+
+// Last: the target's corners stay tracked for the rest of the node's life.
+TEST_F(TrackerNodeletTest, StartUpTargetCornersAreFlaggedAndTracked) {
+  const IndoorScene scene = makeRoom(RoomParams());
+  const CameraModel camera;
+  const SceneRenderer renderer(scene, camera, RenderOptions());
+  TrajectoryParams path;
+  for (int k = 0; k < 3; ++k) {
+    const Pose pose = trajectoryPose(path, k / 30.0);
+    auto tracks = send(makeImage(renderer.render(pose), "mono8", stamp_ += 1.0 / 30));
+    ASSERT_TRUE(tracks);
+    std::vector<cv::Point2d> flagged;
+    for (size_t i = 0; i < tracks->id.size(); ++i) {
+      if (!(tracks->flags[i] & Tracks::FLAG_TARGET_CORNER)) continue;
+      flagged.emplace_back(tracks->u[i], tracks->v[i]);
+      EXPECT_TRUE(tracks->flags[i] & (k == 0 ? Tracks::FLAG_NEW : Tracks::FLAG_TRACKED));
+    }
+    ASSERT_EQ(flagged.size(), 4u) << "image " << k;
+    for (int c = 0; c < 4; ++c) {
+      const cv::Point2d truth = camera.project(pose.inverse().apply(scene.target.corners[c]));
+      EXPECT_LT(cv::norm(flagged[c] - truth), 0.5) << "corner " << c << " image " << k;
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tracker_nodelet");
+  ros::NodeHandle nh;
+  readTimeoutScale();
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "mono_plane_detection/planes/coplanar_groups.h"
+#include "mono_plane_detection/planes/cross_ratio.h"
+#include "mono_plane_detection/sim/synthetic_two_view.h"
+
+using namespace mono_plane_detection;
+
+TEST(CoplanarGroups, DistanceRowsAreEuclidean) {
+  const std::vector<cv::Point2d> p{{0, 0}, {3, 4}, {6, 8}};
+  const cv::Mat rows = distanceRows(p, {1, 0});
+  ASSERT_EQ(rows.rows, 2);
+  ASSERT_EQ(rows.cols, 3);
+  EXPECT_DOUBLE_EQ(rows.at<double>(0, 0), 5.0);
+  EXPECT_DOUBLE_EQ(rows.at<double>(0, 1), 0.0);
+  EXPECT_DOUBLE_EQ(rows.at<double>(1, 2), 10.0);
+}
+
+TEST(CoplanarGroups, GroupsAreNearWellSpreadDistinctAndDeterministic) {
+  TwoViewSceneParams sp;
+  sp.outlier_fraction = 0;
+  const auto scene = makeTwoViewScene(sp);
+  GroupParams params;
+  const auto groups = buildGroups(scene.view2, params, 200);
+  ASSERT_EQ(groups.size(), 200u);
+  for (const auto& g : groups) {
+    EXPECT_EQ(std::set<int>(g.begin(), g.end()).size(), 5u);
+    std::array<cv::Point2d, 5> pts;
+    for (int k = 0; k < 5; ++k) pts[k] = scene.view2[g[k]];
+    EXPECT_TRUE(wellSpread(pts, params.min_shape));
+    // Every member is among the seed's 10 nearest points at 30 px or more.
+    std::vector<double> d;
+    for (const auto& q : scene.view2) {
+      const double r = cv::norm(q - pts[0]);
+      if (r >= params.min_neighbour_distance_px) d.push_back(r);
+    }
+    std::nth_element(d.begin(), d.begin() + 9, d.end());
+    for (int k = 1; k < 5; ++k) {
+      EXPECT_GE(cv::norm(pts[k] - pts[0]), params.min_neighbour_distance_px);
+      EXPECT_LE(cv::norm(pts[k] - pts[0]), d[9] + 1e-9);
+    }
+  }
+  EXPECT_EQ(buildGroups(scene.view2, params, 200), groups);
+  params.seed = 2;
+  EXPECT_NE(buildGroups(scene.view2, params, 200), groups);
+}
+
+TEST(CoplanarGroups, TightClustersFallBackToTheNearestPoints) {
+  // All points within 20 px: none is 30 px from a seed, the nearest are used instead.
+  const std::vector<cv::Point2d> tight{{0, 0}, {10, 1}, {9, 12}, {-1, 8}, {2, 19}, {15, 15}};
+  const auto groups = buildGroups(tight, GroupParams(), 5);
+  EXPECT_EQ(groups.size(), 5u);
+}
+
+TEST(CoplanarGroups, FewerThanFivePointsGiveNoGroup) {
+  EXPECT_TRUE(buildGroups({{0, 0}, {1, 0}, {0, 1}, {1, 1}}, GroupParams(), 10).empty());
+  const std::vector<cv::Point2d> five{{0, 0}, {100, 10}, {90, 120}, {-10, 80}, {20, 115}};
+  EXPECT_FALSE(buildGroups(five, GroupParams(), 3).empty());
+}
+
+TEST(CoplanarGroups, InvariantTestSeparatesPlaneFromMixedGroups) {
+  TwoViewSceneParams sp;
+  sp.planes = 2;
+  sp.outlier_fraction = 0;
+  sp.noise_px = 0.0;
+  const auto scene = makeTwoViewScene(sp);
+  GroupParams params;
+  int same_ok = 0, same = 0, mixed_ok = 0, mixed = 0;
+  for (const auto& g : buildGroups(scene.view2, params, 2000)) {
+    std::array<cv::Point2d, 5> in_view1;
+    for (int k = 0; k < 5; ++k) in_view1[k] = scene.view1[g[k]];
+    if (!wellSpread(in_view1, params.min_shape)) {  // degenerate there: always rejected
+      EXPECT_FALSE(isCoplanarGroup(g, scene.view1, scene.view2, params));
+      continue;
+    }
+    std::set<int> labels;
+    for (int i : g) labels.insert(scene.labels[i]);
+    const bool ok = isCoplanarGroup(g, scene.view1, scene.view2, params);
+    if (labels.size() == 1) {
+      ++same;
+      same_ok += ok;
+    } else {
+      ++mixed;
+      mixed_ok += ok;
+    }
+  }
+  ASSERT_GT(same, 100);
+  ASSERT_GT(mixed, 20);
+  EXPECT_EQ(same_ok, same);  // exact data: every single-plane group passes
+  EXPECT_LT(static_cast<double>(mixed_ok) / mixed, 0.2);
+}
+
+TEST(CoplanarGroups, FindStopsAtTheCapAndCountsTries) {
+  TwoViewSceneParams sp;
+  sp.outlier_fraction = 0.5;
+  const auto scene = makeTwoViewScene(sp);
+  GroupParams params;
+  params.max_groups = 40;
+  const auto found = findCoplanarGroups(scene.view1, scene.view2, params);
+  EXPECT_EQ(found.groups.size(), 40u);
+  EXPECT_GE(found.tried, 40);
+  EXPECT_LE(found.tried, params.max_tries);
+  for (const auto& g : found.groups)
+    EXPECT_TRUE(isCoplanarGroup(g, scene.view1, scene.view2, params));
+}

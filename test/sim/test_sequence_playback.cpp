@@ -1,0 +1,56 @@
+// A bag from writeSequence played by `rosbag play`: every image, camera_info and tf
+// arrives, in order, with its stamp.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <cstdlib>
+#include <thread>
+
+#include "../../src/sim/bag/sequence_writer.h"
+#include "support/test_timeouts.h"
+
+using namespace mono_plane_detection;
+
+TEST(SequencePlayback, RosbagPlayDeliversEverything) {
+  SequenceSpec spec;
+  spec.frames = 30;
+  spec.camera.size = {320, 240};
+  spec.camera.fx = spec.camera.fy = 262.5;
+  spec.camera.cx = 159.5;
+  spec.camera.cy = 119.5;
+  const std::string bag = std::string(::testing::TempDir()) + "playback.bag";
+  writeSequence(spec, bag, std::string(::testing::TempDir()) + "playback.yaml");
+
+  ros::NodeHandle nh;
+  std::vector<double> image_stamps;
+  int infos = 0, tfs = 0;
+  auto on_image = [&](const sensor_msgs::ImageConstPtr& m) {
+    image_stamps.push_back(m->header.stamp.toSec());
+  };
+  ros::Subscriber images = nh.subscribe<sensor_msgs::Image>("/camera/image_raw", 100, on_image);
+  ros::Subscriber info = nh.subscribe<sensor_msgs::CameraInfo>(
+      "/camera/camera_info", 100, [&](const sensor_msgs::CameraInfoConstPtr&) { ++infos; });
+  ros::Subscriber tf = nh.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr&) { ++tfs; });
+
+  // -d 2: rosbag play waits after advertising so that the subscribers connect.
+  std::thread player([&] { EXPECT_EQ(std::system(("rosbag play -q -d 2 " + bag).c_str()), 0); });
+  spinUntil([&] { return image_stamps.size() >= 30; }, 30.0);
+  player.join();
+  ros::spinOnce();
+  ASSERT_EQ(image_stamps.size(), 30u);
+  for (size_t k = 0; k < image_stamps.size(); ++k)
+    EXPECT_NEAR(image_stamps[k], 1000.0 + k / 30.0, 1e-6);
+  EXPECT_EQ(infos, 30);
+  EXPECT_EQ(tfs, 30);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_sequence_playback");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,67 @@
+// Validation of incoming track frames and matching by id.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "mono_plane_detection/tracking/track_frame.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+TrackFrame good() {
+  TrackFrame f;
+  f.size = {640, 480};
+  f.ids = {1, 2, 3};
+  f.pixels = {{10, 10}, {641.4, 481.4}, {-2.4, 0}};  // within the 2 px border margin
+  f.target_corner = {false, false, true};
+  return f;
+}
+
+}  // namespace
+
+TEST(TrackFrame, AcceptsAWellFormedFrame) { EXPECT_EQ(validateTrackFrame(good()), ""); }
+
+TEST(TrackFrame, NamesWhatIsWrong) {
+  TrackFrame f = good();
+  f.pixels.pop_back();
+  EXPECT_NE(validateTrackFrame(f).find("array lengths differ"), std::string::npos);
+  f = good();
+  f.pixels[1].x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validateTrackFrame(f).find("non-finite"), std::string::npos);
+  f = good();
+  f.pixels[0].y = std::numeric_limits<double>::infinity();
+  EXPECT_NE(validateTrackFrame(f).find("non-finite"), std::string::npos);
+  f = good();
+  f.pixels[0] = {700, 10};
+  EXPECT_NE(validateTrackFrame(f).find("outside"), std::string::npos);
+  f = good();
+  f.pixels[0] = {10, 481.6};  // just beyond the margin
+  EXPECT_NE(validateTrackFrame(f).find("outside"), std::string::npos);
+  f = good();
+  f.ids[2] = 1;
+  EXPECT_NE(validateTrackFrame(f).find("appears twice"), std::string::npos);
+  f = good();
+  f.size = {0, 0};
+  EXPECT_NE(validateTrackFrame(f).find("empty"), std::string::npos);
+}
+
+TEST(TrackFrame, EmptyFrameIsValid) {
+  TrackFrame f;
+  f.size = {320, 240};
+  EXPECT_EQ(validateTrackFrame(f), "");
+}
+
+TEST(TrackFrame, MatchByIdPairsTheSamePoints) {
+  TrackFrame a = good(), b = good();
+  b.ids = {3, 9, 1};
+  b.pixels = {{5, 5}, {6, 6}, {7, 7}};
+  const TrackPairs c = matchById(a, b);
+  ASSERT_EQ(c.ids.size(), 2u);
+  EXPECT_EQ(c.ids[0], 3u);
+  EXPECT_EQ(c.first[0], cv::Point2d(-2.4, 0));
+  EXPECT_EQ(c.second[0], cv::Point2d(5, 5));
+  EXPECT_EQ(c.ids[1], 1u);
+  EXPECT_EQ(c.first[1], cv::Point2d(10, 10));
+  EXPECT_EQ(c.second[1], cv::Point2d(7, 7));
+}
