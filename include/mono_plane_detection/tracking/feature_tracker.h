@@ -50,10 +50,7 @@ struct TrackerParams {
 struct TrackedPoint {
   std::uint64_t id = 0;  // unique, increasing, never reused
   cv::Point2f uv;        // pixel position in the current image
-  // Estimated 3D position in metres (map frame); NaN until the plane side fills it.
-  cv::Point3f position{std::numeric_limits<float>::quiet_NaN(),
-                       std::numeric_limits<float>::quiet_NaN(),
-                       std::numeric_limits<float>::quiet_NaN()};
+  // (The paper's 3D position lives with the landmarks: mapping/pose_estimator.h.)
   bool is_new = false;            // found by the search on this image
   bool is_tracked = false;        // followed by Lucas-Kanade from the previous image
   bool is_reidentified = false;   // new corner that got back the id of a lost point
