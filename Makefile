@@ -41,14 +41,17 @@ build: deps link
 	@$(CATKIN) > $(WS)/build.log 2>&1 || { tail -40 $(WS)/build.log; exit 1; }
 
 # The main job. BAG=your.bag [TRUTH=its.yaml] replays your own bag; RVIZ=1 shows rviz
-# (installs it) instead of running headless; PROFILE=wheeled|humanoid; RESULTS=folder.
+# (installs it) instead of running headless; PROFILE=wheeled|humanoid; RESULTS=folder;
+# CAMERA=namespace IMAGE=topic name: where the bag's images are (camera, image_raw).
 RESULTS ?= $(REPO)/results
+CAMERA ?= camera
+IMAGE ?= image_raw
 PROFILE ?= humanoid
 FRAMES ?= 300
 RVIZ ?= 0
 demo: build
 	@[ "$(RVIZ)" != 1 ] || scripts/install_deps.sh rviz libgl1-mesa-dri
-	@source $(DEVEL) && scripts/demo.sh $(RESULTS) $(PROFILE) $(FRAMES) \
+	@source $(DEVEL) && DEMO_CAMERA=$(CAMERA) DEMO_IMAGE=$(IMAGE) scripts/demo.sh $(RESULTS) $(PROFILE) $(FRAMES) \
 	  $(if $(filter 1,$(RVIZ)),true,false) $(if $(BAG),$(abspath $(BAG))) $(if $(TRUTH),$(abspath $(TRUTH)))
 
 # The data-race check: both nodelet rostests with their manager (4 worker threads, three

@@ -22,4 +22,4 @@ roslaunch -p "$port" mono_plane_detection plane_detection.launch profile:=wheele
   > "$results/latency_pipeline.log" 2>&1 &
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
-rosrun mono_plane_detection benchmark_latency _bag:="$bag" _rate:=30
+rosrun mono_plane_detection benchmark_latency --bag "$bag" --rate 30

@@ -3,8 +3,43 @@
 # through the nodelet pipeline (roslaunch, rosbag play, simulated time) and prints the
 # report of demo_report. Called by the Makefile with the workspace sourced.
 #   scripts/demo.sh RESULTS PROFILE FRAMES RVIZ [BAG [TRUTH]]
+# Environment: DEMO_CAMERA (camera namespace, default camera), DEMO_IMAGE (image topic in
+# it, default image_raw), DEMO_FIRST_MESSAGE_TIMEOUT (s, default 60).
+# Fails fast (exit 2, before anything is started) on an unknown profile, a missing or
+# unreadable bag, or a bag without the camera's image or camera_info topic; exits 1
+# when the pipeline sends nothing within the timeout.
 set -euo pipefail
 results=$1 profile=$2 frames=$3 rviz=$4 bag=${5:-} truth=${6:-}
+camera=${DEMO_CAMERA:-camera} image=${DEMO_IMAGE:-image_raw}
+camera=${camera#/} camera=${camera%/}
+image_topic=/$camera/$image info_topic=/$camera/camera_info
+config=$(cd "$(dirname "$0")/../config" && pwd)
+die() { echo "demo: $*" >&2; exit 2; }
+
+if [ ! -f "$config/tracker_$profile.yaml" ] || [ ! -f "$config/planes_$profile.yaml" ]; then
+  known=$(cd "$config" && ls tracker_*.yaml | sed 's/tracker_\(.*\)\.yaml/\1/' | tr '\n' ' ')
+  die "unknown profile '$profile' (no config/tracker_$profile.yaml); profiles: $known"
+fi
+if [ -n "$bag" ]; then
+  [ -f "$bag" ] || die "no bag file $bag"
+  [ -r "$bag" ] || die "cannot read the bag $bag"
+  topics=$(python3 - "$bag" <<'PYTHON'
+import sys
+import rosbag
+try:
+    with rosbag.Bag(sys.argv[1]) as bag:
+        print('\n'.join(sorted(bag.get_type_and_topic_info().topics)))
+except Exception as e:  # not a bag, truncated, unindexed...
+    print('demo: cannot read the bag %s: %s' % (sys.argv[1], e), file=sys.stderr)
+    sys.exit(2)
+PYTHON
+) || exit 2
+  for topic in "$image_topic" "$info_topic"; do
+    grep -qxF "$topic" <<< "$topics" || die "the bag $bag has no topic $topic (it has: \
+$(echo $topics)); choose the camera with CAMERA=namespace IMAGE=image_topic_name"
+  done
+fi
+
 mkdir -p "$results"
 if [ -z "$bag" ]; then
   echo "demo: rendering a $frames-image $profile sequence (room, start-up target, ground truth)"
@@ -15,17 +50,21 @@ else
   frames=0  # unknown: the report ends when the bag has been silent for a while
 fi
 log=$results/pipeline.log
-echo "demo: playing $bag through tracker + planes (profile $profile); log in $log"
+echo "demo: playing $bag through tracker + planes (profile $profile, $image_topic); log in $log"
 # Own master on a free port, so a running roscore is left alone.
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI=http://localhost:$port
 roslaunch -p "$port" mono_plane_detection replay.launch bag:="$bag" profile:="$profile" \
-  rviz:="$rviz" player_required:=false > "$log" 2>&1 &
+  camera:="$camera" image:="$image" rviz:="$rviz" player_required:=false > "$log" 2>&1 &
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
 for _ in $(seq 100); do rosparam get /use_sim_time >/dev/null 2>&1 && break; sleep 0.2; done
 status=0
-rosrun mono_plane_detection demo_report planes:=/camera/planes tracks:=/camera/tracks \
-  image:=/camera/image_raw _out:="$results" _truth:="$truth" _frames:="$frames" || status=$?
+report_args=(--out "$results" --frames "$frames"
+  --first-message-timeout "${DEMO_FIRST_MESSAGE_TIMEOUT:-60}")
+[ -z "$truth" ] || report_args+=(--truth "$truth")
+rosrun mono_plane_detection demo_report planes:=/$camera/planes tracks:=/$camera/tracks \
+  image:="$image_topic" "${report_args[@]}" || status=$?
 grep -E "ERROR|FATAL" "$log" | head -5 || true
+[ $status -eq 0 ] || echo "demo: failed (exit $status); the pipeline's log: $log" >&2
 exit $status

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_args.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
@@ -232,18 +233,13 @@ void plot(const std::vector<PlaneRow>& planes,
 int main(int argc, char** argv) {
   int count = 100, repeats = 20;
   std::string plot_path = "benchmark.png";
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc)
-      count = std::max(20, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
-      repeats = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--plot") && i + 1 < argc)
-      plot_path = argv[++i];
-    else {
-      std::printf("usage: benchmark_suite [--frames N] [--repeats N] [--plot file.png]\n");
-      return std::strcmp(argv[i], "--help") ? 2 : 0;
-    }
-  }
+  cli::Parser cli("benchmark_suite", "[options]",
+                  "  The benchmark suite: tracker and plane segmentation, ours against\n"
+                  "  baselines, with a plot. Figures, never pass/fail.");
+  cli.integer("frames", &count, 20, 100000, "generated frames per tracker row")
+      .integer("repeats", &repeats, 1, 10000, "scenes per plane row")
+      .text("plot", &plot_path, "where to write the plot", "FILE.png");
+  if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
   std::printf(
       "benchmark_suite: one thread; %d generated frames per tracker row, %d scenes per "

@@ -2,7 +2,7 @@
 // what it found and writes results: an overlay of a late image, a top-down map and the
 // planes as YAML. With the ground truth of a generated sequence it also prints each
 // plane's errors and the camera path error. Used by `make demo`.
-//   rosrun mono_plane_detection demo_report _out:=results _truth:=seq.yaml _frames:=300
+//   rosrun mono_plane_detection demo_report --out results --truth seq.yaml --frames 300
 #include <cv_bridge/cv_bridge.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "../sim/bag/ground_truth.h"
+#include "cli_args.h"
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 
@@ -38,17 +39,30 @@ struct Timing {
   }
 };
 
+struct ReportOptions {
+  std::string out = "results", truth;
+  int frames = 0;                      // expected plane messages; 0: unknown
+  double idle_timeout_s = 10;          // silence after the last message that ends the input
+  double first_message_timeout_s = 60; // no first message by then: the pipeline is not running
+};
+
 class Report {
  public:
-  Report(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-    pnh.param<std::string>("out", out_, "results");
-    pnh.param<std::string>("truth", truth_path_, "");
-    pnh.param("frames", expected_, 0);
-    pnh.param("idle_timeout_s", idle_timeout_s_, 10.0);
+  Report(ros::NodeHandle& nh, const ReportOptions& options)
+      : out_(options.out),
+        truth_path_(options.truth),
+        expected_(options.frames),
+        idle_timeout_s_(options.idle_timeout_s),
+        first_message_timeout_s_(options.first_message_timeout_s) {
     if (!truth_path_.empty()) truth_ = loadGroundTruth(truth_path_);
     planes_sub_ = nh.subscribe("planes", 50, &Report::onPlanes, this);
     tracks_sub_ = nh.subscribe("tracks", 50, &Report::onTracks, this);
     image_sub_ = nh.subscribe("image", 50, &Report::onImage, this);
+  }
+
+  // True when no message came within the first-message timeout.
+  bool timedOut() const {
+    return planes_seen_ == 0 && (ros::WallTime::now() - started_).toSec() > first_message_timeout_s_;
   }
 
   // True when the input has ended (all frames, or silence after the first message).
@@ -257,7 +271,8 @@ class Report {
  private:
   std::string out_, truth_path_;
   int expected_ = 0, planes_seen_ = 0;
-  double idle_timeout_s_ = 10;
+  double idle_timeout_s_ = 10, first_message_timeout_s_ = 60;
+  const ros::WallTime started_ = ros::WallTime::now();
   std::optional<GroundTruth> truth_;
   ros::Subscriber planes_sub_, tracks_sub_, image_sub_;
   ros::WallTime last_message_ = ros::WallTime::now();
@@ -274,12 +289,48 @@ class Report {
 }  // namespace
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "demo_report");
-  ros::NodeHandle nh, pnh("~");
+  ros::init(argc, argv, "demo_report");  // takes the remappings (planes:=...) out of argv
+  ReportOptions options;
+  cli::Parser cli(
+      "demo_report", "[options] [planes:=TOPIC tracks:=TOPIC image:=TOPIC]",
+      "  Listens to a running pipeline (tracks, planes, image) and, when the input ends,\n"
+      "  prints what it found and writes an overlay, a top-down map and the planes as YAML.\n"
+      "  With the ground truth of a generated sequence it also prints each plane's errors.",
+      "exit codes: 0 planes found, 1 no plane or no message before the timeout, 2 bad usage\n");
+  cli.text("out", &options.out, "folder for the results", "DIR")
+      .text("truth", &options.truth, "ground truth YAML of make_sequence", "FILE")
+      .integer("frames", &options.frames, 0, 10000000,
+               "plane messages to expect (0: until the input is silent)")
+      .number("idle-timeout", &options.idle_timeout_s, 0.1, 3600.0,
+              "silence after the last message that ends the input, s", "S")
+      .number("first-message-timeout", &options.first_message_timeout_s, 0.1, 3600.0,
+              "give up when no message came by then, s", "S");
+  if (const auto code = cli.parse(argc, argv)) return *code;
+  if (!options.truth.empty() && !std::ifstream(options.truth))
+    return cli.fail("cannot read the ground truth " + options.truth);
+  // Without a master, subscribing would wait for ever: wait as long as for a message.
+  const ros::WallTime give_up =
+      ros::WallTime::now() + ros::WallDuration(options.first_message_timeout_s);
+  while (!ros::master::check()) {
+    if (ros::WallTime::now() > give_up) {
+      std::fprintf(stderr, "demo_report: no ROS master at %s within %.0f s\n",
+                   ros::master::getURI().c_str(), options.first_message_timeout_s);
+      return 1;
+    }
+    ros::WallDuration(0.2).sleep();
+  }
+  ros::NodeHandle nh;
   try {
-    Report report(nh, pnh);
+    Report report(nh, options);
     ros::WallRate rate(200);  // wall clock: simulated time stops with the bag
     while (ros::ok() && !report.done()) {
+      if (report.timedOut()) {
+        std::fprintf(stderr,
+                     "demo_report: no message on %s within %.0f s: is the pipeline running, "
+                     "and does the bag hold the camera's image and camera_info topics?\n",
+                     ros::names::resolve("planes").c_str(), options.first_message_timeout_s);
+        return 1;
+      }
       ros::spinOnce();
       report.recordPath();
       rate.sleep();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -16,23 +17,6 @@
 using namespace mono_plane_detection;
 
 namespace {
-
-const char* kUsage =
-    "usage: segment_planes [options] FILE|-\n"
-    "  Finds every dominant plane (homography) in two-view correspondences.\n"
-    "  FILE: one correspondence per line 'x1 y1 x2 y2' (pixels, view 1 then view 2),\n"
-    "        '#' starts a comment; '-' reads standard input.\n"
-    "  Output: one integer per correspondence, in order: 0 = no plane, k >= 1 = plane k\n"
-    "          (planes numbered by support, largest first).\n"
-    "options:\n"
-    "  --threshold PX     transfer error for a point to vote / belong (default 2.0)\n"
-    "  --max-planes K     at most K planes (default 8)\n"
-    "  --min-support N    a plane needs at least N points (default 8)\n"
-    "  --invariant-threshold T  five-point invariant agreement (default 0.1)\n"
-    "  --seed S           seed of the group choice (default 1)\n"
-    "  --json             print planes (homography, inliers, rms error) instead of labels\n"
-    "  --help             this text\n"
-    "exit codes: 0 done (fewer than 5 points: all labels 0), 2 bad usage or input\n";
 
 void printJson(const PlaneSegmentation& result, size_t points) {
   std::printf(
@@ -56,67 +40,45 @@ void printJson(const PlaneSegmentation& result, size_t points) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  auto fail = [](const std::string& what) { return usageError("segment_planes", what, kUsage); };
   PlaneParams params;
   bool json = false;
   std::string path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-    double d;
-    long n;
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (arg == "--json") {
-      json = true;
-    } else if (arg == "--threshold") {
-      const char* v = value();
-      if (!v || !parseNumber(v, d) || d <= 0)
-        return fail("--threshold needs a positive number of pixels");
-      params.vote_threshold_px = d;
-    } else if (arg == "--invariant-threshold") {
-      const char* v = value();
-      if (!v || !parseNumber(v, d) || d <= 0)
-        return fail("--invariant-threshold needs a positive number");
-      params.groups.invariant_threshold = d;
-    } else if (arg == "--max-planes") {
-      const char* v = value();
-      if (!v || !parseInteger(v, n) || n < 1) return fail("--max-planes needs a whole number >= 1");
-      params.max_planes = static_cast<int>(n);
-    } else if (arg == "--min-support") {
-      const char* v = value();
-      if (!v || !parseInteger(v, n) || n < 4)
-        return fail("--min-support needs a whole number >= 4");
-      params.min_plane_support = static_cast<int>(n);
-    } else if (arg == "--seed") {
-      const char* v = value();
-      if (!v || !parseInteger(v, n) || n < 0) return fail("--seed needs a whole number >= 0");
-      params.groups.seed = static_cast<unsigned>(n);
-    } else if (arg.size() > 1 && arg[0] == '-' && arg != "-") {
-      return fail("unknown option " + arg);
-    } else if (path.empty()) {
-      path = arg;
-    } else {
-      return fail("more than one input file");
-    }
-  }
-  if (path.empty()) return fail("no input file");
+  cli::Parser cli("segment_planes", "[options] FILE|-",
+                  "  Finds every dominant plane (homography) in two-view correspondences.",
+                  "input: one correspondence per line 'x1 y1 x2 y2' (pixels, view 1 then view 2),\n"
+                  "  '#' starts a comment; lines longer than " +
+                      std::to_string(kMaxCorrespondenceLineBytes) + " bytes are refused.\n"
+                  "output: one integer per correspondence, in order: 0 = no plane, k >= 1 = plane k\n"
+                  "  (planes numbered by support, largest first).\n"
+                  "exit codes: 0 done (fewer than 5 points: all labels 0), 2 bad usage or input\n");
+  cli.positional("FILE", &path, "the correspondences; '-' reads standard input")
+      .number("threshold", &params.vote_threshold_px, 1e-3, 1e3,
+              "transfer error for a point to vote / belong, pixels", "PX")
+      .integer("max-planes", &params.max_planes, 1, 1000, "at most K planes", "K")
+      .integer("min-support", &params.min_plane_support, 4, 1000000,
+               "a plane needs at least N points")
+      .number("invariant-threshold", &params.groups.invariant_threshold, 1e-6, 10.0,
+              "five-point invariant agreement", "T")
+      .integer<unsigned>("seed", &params.groups.seed, 0, std::numeric_limits<unsigned>::max(),
+                         "seed of the group choice", "S")
+      .flag("json", &json, "print planes (homography, inliers, rms error) instead of labels");
+  if (const auto code = cli.parse(argc, argv)) return *code;
 
   Correspondences input;
   if (path == "-") {
     input = readCorrespondences(std::cin);
   } else {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+      return cli.fail(path + " is a directory, not a file of correspondences");
     std::ifstream file(path);
-    if (!file) {
-      std::fprintf(stderr, "segment_planes: cannot open %s\n", path.c_str());
-      return 2;
-    }
+    if (!file) return cli.fail("cannot open " + path);
     input = readCorrespondences(file);
+    if (file.bad()) return cli.fail("cannot read " + path);
   }
   if (!input.error.empty()) {
     std::fprintf(stderr, "segment_planes: %s: %s\n", path.c_str(), input.error.c_str());
-    return 2;
+    return cli::kExitUsage;
   }
 
   const PlaneSegmentation result = segmentPlanes(input.view1, input.view2, params);

@@ -39,3 +39,51 @@ TEST(MakeSequenceCli, BadUsageExitsTwoAndSaysWhy) {
   EXPECT_EQ(run("--frobnicate 1 --out x.bag").code, 2);
   EXPECT_EQ(run("--frames 2 --out /no/such/folder/x.bag").code, 1);
 }
+
+namespace {
+// Bounded: the old program ran for ever on some of these; `timeout` turns that into a
+// failure (exit 124) instead of a hung test.
+ProgramRun runBounded(const std::string& args) {
+  return runProgram(std::string("timeout 30 ") + MAKE_SEQUENCE_PATH, args);
+}
+std::string temp(const std::string& name) { return std::string(::testing::TempDir()) + name; }
+}  // namespace
+
+// Issue 15 item 13: sizes and counts are bounded with a clear message (the old program
+// died of bad_alloc, SIGABRT, or ran until killed).
+TEST(MakeSequenceCli, SizesAndCountsAreBounded) {
+  const std::string bag = temp("bounded.bag");
+  for (const std::string& option :
+       {std::string("--width 100000 --height 100000"), std::string("--supersample 1000"),
+        std::string("--frames 1000000000"), std::string("--blur 100000"),
+        std::string("--width 8192 --height 8192"), std::string("--width 4096 --height 4096 --supersample 2"),
+        std::string("--frames 2147483648"), std::string("--fps 1e300")}) {
+    const ProgramRun r = runBounded(option + " --quiet --out " + bag);
+    EXPECT_EQ(r.code, 2) << option << ": " << r.err;
+    EXPECT_FALSE(r.err.empty()) << option;
+    EXPECT_FALSE(exists(bag)) << option;
+  }
+}
+
+// Issue 15 item 13: --out X --yaml X wrote the bag, then the YAML over it, and exited 0.
+TEST(MakeSequenceCli, OutputsNeverOverwriteEachOther) {
+  const std::string bag = temp("same.bag");
+  for (const std::string& yaml : {bag, temp("./same.bag"), temp("../") +
+                                                               std::string(::testing::TempDir())
+                                                                   .substr(1) +
+                                                               "same.bag"}) {
+    const ProgramRun r = runBounded("--frames 2 --width 64 --height 48 --quiet --out " + bag +
+                                    " --yaml " + yaml);
+    EXPECT_EQ(r.code, 2) << yaml << ": " << r.err;
+    EXPECT_NE(r.err.find("same file"), std::string::npos) << r.err;
+    EXPECT_FALSE(exists(bag));
+  }
+}
+
+// Exit code 1 (cannot write) comes from a typed error, not from the message text.
+TEST(MakeSequenceCli, UnwritableYamlExitsOne) {
+  const ProgramRun r = runBounded("--frames 2 --width 64 --height 48 --quiet --out " +
+                                  temp("ok.bag") + " --yaml /no/such/folder/x.yaml");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("cannot write"), std::string::npos);
+}

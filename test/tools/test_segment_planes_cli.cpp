@@ -72,3 +72,43 @@ TEST(SegmentPlanesCli, OptionsAndUsage) {
   const std::string few = writeFile("few2.txt", "1 2 3 4\n");
   EXPECT_EQ(run("--threshold 3 --min-support 5 --seed 7 " + few).code, 0);
 }
+
+// Issue 15 item 10: values a long holds but an int does not were truncated (exit 0, every
+// label 0); now refused with the range.
+TEST(SegmentPlanesCli, CountsOutsideIntAreRefusedNotTruncated) {
+  const std::string few = writeFile("few3.txt", "1 2 3 4\n");
+  for (const char* option : {"--max-planes 4294967295", "--max-planes 2147483648",
+                             "--min-support 4294967296", "--min-support 2147483652",
+                             "--seed 4294967296", "--seed -1"}) {
+    const ProgramRun r = run(std::string(option) + " " + few);
+    EXPECT_EQ(r.code, 2) << option;
+    EXPECT_NE(r.err.find("range"), std::string::npos) << option << ": " << r.err;
+  }
+  EXPECT_EQ(run("--seed 4294967295 " + few).code, 0);
+}
+
+// Issue 15 item 12: a directory was read as an empty file (exit 0, no output).
+TEST(SegmentPlanesCli, ADirectoryIsRefused) {
+  const ProgramRun r = run(::testing::TempDir());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("directory"), std::string::npos) << r.err;
+}
+
+// Issue 15 item 9: a huge line is refused by its length, read as a stream.
+TEST(SegmentPlanesCli, AVeryLongLineIsRefusedByItsLength) {
+  std::string line;
+  for (int i = 0; i < 100000; ++i) line += "1 ";
+  const ProgramRun r = run(writeFile("long.txt", "1 2 3 4\n" + line + "\n"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("line 2: longer than"), std::string::npos) << r.err;
+}
+
+// Issue 15 item 12: subnormal input is read; a NUL inside a number is not.
+TEST(SegmentPlanesCli, SubnormalReadEmbeddedNulRefused) {
+  ProgramRun r = run(writeFile("subnormal.txt", "1e-320 2 3 4\n"));
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "0\n");
+  r = run(writeFile("nul.txt", std::string("1.0\0junk 2 3 4\n", 15)));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("line 1"), std::string::npos) << r.err;
+}

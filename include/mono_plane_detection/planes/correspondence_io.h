@@ -2,6 +2,7 @@
 // view 2), '#' starts a comment, blank lines are skipped.
 #pragma once
 
+#include <cstddef>
 #include <istream>
 #include <opencv2/core.hpp>
 #include <string>
@@ -15,8 +16,14 @@ struct Correspondences {
   int error_line = 0;  // 1-based line of the error
 };
 
-// Stops at the first malformed line: not exactly four numbers, a number that is not
-// finite, or trailing text.
+// Longest line read, comment included. The input is read as a stream, one line at a
+// time, so memory stays bounded by this whatever the file holds (a 1 GB line took 17 GB
+// when every token was copied before the fields were counted).
+constexpr std::size_t kMaxCorrespondenceLineBytes = 64 * 1024;
+
+// Stops at the first malformed line: longer than kMaxCorrespondenceLineBytes, not
+// exactly four numbers, a number that is not finite (subnormals are finite), a NUL byte
+// inside a number, or trailing text.
 Correspondences readCorrespondences(std::istream& in);
 
 }  // namespace mono_plane_detection

@@ -40,18 +40,20 @@ sensor_msgs::CameraInfo cameraInfo(const SequenceSpec& spec, const std_msgs::Hea
 }
 
 void validate(const SequenceSpec& spec) {
-  if (spec.frames < 1) throw std::runtime_error("frames must be at least 1");
-  if (!(spec.fps > 0)) throw std::runtime_error("fps must be positive");
+  if (spec.frames < 1) throw SequenceSpecError("frames must be at least 1");
+  if (!(spec.fps > 0)) throw SequenceSpecError("fps must be positive");
+  // Images 1/fps apart in ros::Time (nanoseconds): at 1e300 fps every stamp was equal.
+  if (!(spec.fps <= 1e6)) throw SequenceSpecError("fps must be at most 1e6 (distinct stamps)");
   if (!(spec.exposure_swing >= 0 && spec.exposure_swing < 1))
-    throw std::runtime_error("exposure swing must be in [0, 1)");
+    throw SequenceSpecError("exposure swing must be in [0, 1)");
   if (spec.encoding != "mono8" && spec.encoding != "bgr8")
-    throw std::runtime_error("encoding must be mono8 or bgr8, not '" + spec.encoding + "'");
+    throw SequenceSpecError("encoding must be mono8 or bgr8, not '" + spec.encoding + "'");
   if (spec.camera.size.width < 1 || spec.camera.size.height < 1 || !(spec.camera.fx > 0) ||
       !(spec.camera.fy > 0))
-    throw std::runtime_error("camera size and focal lengths must be positive");
+    throw SequenceSpecError("camera size and focal lengths must be positive");
   const std::string& name = spec.trajectory.name;
   if (name != "wheeled" && name != "humanoid" && name != "rotation")
-    throw std::runtime_error("trajectory must be wheeled, humanoid or rotation, not '" + name +
+    throw SequenceSpecError("trajectory must be wheeled, humanoid or rotation, not '" + name +
                              "'");
 }
 
@@ -115,7 +117,7 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
     root["camera_gt_in_map"].push_back(entry);
   }
   std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  if (!out) throw SequenceWriteError("cannot write " + path);
   out << "# Ground truth of a synthetic sequence (mono_plane_detection make_sequence)\n"
       << root << "\n";
 }
@@ -136,7 +138,7 @@ SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_pa
   try {
     bag.open(bag_path, rosbag::bagmode::Write);
   } catch (const rosbag::BagException& e) {
-    throw std::runtime_error("cannot write " + bag_path + ": " + e.what());
+    throw SequenceWriteError("cannot write " + bag_path + ": " + e.what());
   }
   SequenceReport report;
   double render_ms = 0;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 #include "mono_plane_detection/sim/camera_trajectory.h"
@@ -33,7 +34,17 @@ struct SequenceReport {
   double render_ms_mean = 0;  // per image, all sub-frames included
 };
 
-// Throws std::runtime_error (bad spec, unwritable file). progress(k) after image k.
+// A spec the writer refuses (the caller's input).
+struct SequenceSpecError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// A file that cannot be written.
+struct SequenceWriteError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Throws SequenceSpecError (bad spec) or SequenceWriteError (unwritable file), both
+// std::runtime_error. progress(k) after image k.
 SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_path,
                              const std::string& yaml_path,
                              const std::function<void(int)>& progress = nullptr);
