@@ -1,7 +1,7 @@
 # Run at every build (cmake -P, from CMakeLists.txt): the product must not depend on the
 # simulator or the judges. Fails the build when a runtime header or source includes a
 # sim/ or eval/ header. SOURCE_DIR is the package's source folder.
-set(runtime geometry tracking planes mapping viz ros nodelets)
+set(runtime geometry tracking planes mapping viz params ros nodelets)
 set(bad_files "")
 foreach(stage ${runtime})
   file(GLOB files ${SOURCE_DIR}/include/mono_plane_detection/${stage}/*.h

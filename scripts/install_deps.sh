@@ -17,6 +17,7 @@ PACKAGES=(
   libtf2-dev libtf2-ros-dev python3-tf2-ros libvisualization-msgs-dev ros-visualization-msgs
   python3-geometry-msgs python3-visualization-msgs
   libyaml-cpp-dev libopencv-dev libeigen3-dev libboost-program-options-dev
+  libimage-geometry-dev
 )
 
 PACKAGES+=("$@")  # extra packages a target needs (make demo RVIZ=1: rviz)

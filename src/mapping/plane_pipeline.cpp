@@ -29,7 +29,14 @@ std::string cameraIntrinsicsError(const cv::Matx33d& K, const cv::Mat& distortio
     why << "focal length fx=" << K(0, 0) << ", fy=" << K(1, 1) << " is not positive";
     return why.str();
   }
+  // cv::undistortPoints takes 4, 5, 8, 12 or 14 coefficients and asserts on any other.
+  const size_t n = distortion.total();
+  if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
+    why << distortion.total() << " distortion coefficients: OpenCV takes 0, 4, 5, 8, 12 or 14";
+    return why.str();
+  }
   if (!distortion.empty()) {
+    if (distortion.channels() != 1) return "distortion coefficients must be one channel";
     cv::Mat d;
     distortion.convertTo(d, CV_64F);
     if (!cv::checkRange(d)) return "a distortion coefficient is not finite";
@@ -39,12 +46,21 @@ std::string cameraIntrinsicsError(const cv::Matx33d& K, const cv::Mat& distortio
 
 PlanePipeline::PlanePipeline(const PipelineParams& params) : params_(params), map_(params.map) {}
 
-void PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distortion) {
-  if (pose_ && K == K_ && cv::norm(distortion, distortion_, cv::NORM_INF) == 0) return;
+std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distortion) {
+  if (std::string error = cameraIntrinsicsError(K, distortion); !error.empty()) return error;
+  cv::Mat d;
+  if (!distortion.empty()) distortion.reshape(1, 1).convertTo(d, CV_64F);
+  // A recalibration may change the number of coefficients (5 -> 8): compare sizes first.
+  const bool same = pose_ && K == K_ && d.size() == distortion_.size() &&
+                    (d.empty() || cv::norm(d, distortion_, cv::NORM_INF) == 0);
+  if (same) return {};
   K_ = K;
-  distortion_ = distortion.clone();
+  distortion_ = d;
   pose_.emplace(K_, distortion_, params_.pose, params_.target);
   map_.reset();
+  history_.clear();
+  previous_planes_.clear();
+  return {};
 }
 
 void PlanePipeline::reset() {

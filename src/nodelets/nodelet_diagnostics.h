@@ -1,5 +1,5 @@
 // The diagnostics both nodelets publish: the input rate (FrequencyStatus, window set by
-// expected_min_rate_hz / expected_max_rate_hz) and one task of the nodelet's own counts,
+// the parameters expected_min_rate_hz / expected_max_rate_hz) and one task of the nodelet's own counts,
 // updated once a second.
 #pragma once
 
@@ -10,6 +10,8 @@
 #include <memory>
 #include <string>
 
+#include "callback_guard.h"
+
 namespace mono_plane_detection {
 
 class NodeletDiagnostics {
@@ -17,17 +19,20 @@ class NodeletDiagnostics {
   template <class Owner>
   void start(ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& name,
              const std::string& task, Owner* owner,
-             void (Owner::*diagnose)(diagnostic_updater::DiagnosticStatusWrapper&)) {
-    pnh.param("expected_min_rate_hz", min_rate_, 5.0);
-    pnh.param("expected_max_rate_hz", max_rate_, 100.0);
+             void (Owner::*diagnose)(diagnostic_updater::DiagnosticStatusWrapper&),
+             CallbackGuard& guard, double min_rate_hz, double max_rate_hz) {
+    min_rate_ = min_rate_hz;
+    max_rate_ = max_rate_hz;
     updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, name);
     updater_->setHardwareID("camera");
     rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
         diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
     updater_->add(*rate_);
     updater_->add(task, owner, diagnose);
-    timer_ =
-        nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
+    timer_ = nh.createTimer(ros::Duration(1.0),
+                            guard.wrap("diagnostics timer", [this](const ros::TimerEvent&) {
+                              updater_->update();
+                            }));
   }
 
   void tick() {

@@ -35,15 +35,26 @@ TrackFrame toTrackFrame(const Tracks& msg, std::string& error) {
   return frame;
 }
 
-std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D) {
-  for (int i = 0; i < 9; ++i) K.val[i] = info.K[i];
-  if (const std::string error = cameraIntrinsicsError(K, cv::Mat()); !error.empty())
-    return error + " (camera_info K)";
-  if (!info.D.empty() && info.distortion_model != "plumb_bob" &&
-      info.distortion_model != "rational_polynomial")
-    return "distortion model '" + info.distortion_model + "' is not supported";
-  D = cv::Mat(info.D, true).reshape(1, 1);
-  if (!D.empty() && !cv::checkRange(D)) return "a distortion coefficient is not finite";
+std::string odometryError(const Pose& odom, const std::optional<Pose>& previous,
+                          double max_jump_m) {
+  for (int i = 0; i < 9; ++i)
+    if (!std::isfinite(odom.R.val[i])) return "its rotation is not finite";
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(odom.t[i])) {
+      std::ostringstream why;
+      why << "its translation (" << odom.t[0] << ", " << odom.t[1] << ", " << odom.t[2]
+          << ") is not finite";
+      return why.str();
+    }
+  if (previous) {
+    const double jump = cv::norm(odom.t - previous->t);
+    if (!(jump <= max_jump_m)) {
+      std::ostringstream why;
+      why << "it moved " << jump << " m since the previous tracks, more than max_odom_jump_m = "
+          << max_jump_m;
+      return why.str();
+    }
+  }
   return {};
 }
 

@@ -6,6 +6,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <optional>
 #include <set>
 #include <string>
 
@@ -18,8 +19,10 @@ namespace mono_plane_detection {
 // The frame, or an error naming what is wrong (array lengths, values).
 TrackFrame toTrackFrame(const Tracks& msg, std::string& error);
 
-// K and distortion from a CameraInfo; an error when unusable (zero, NaN, no K).
-std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D);
+// Empty when an odometry pose can be used: finite, and no further than max_jump_m from
+// the previous one (when there is one); else why not.
+std::string odometryError(const Pose& odom_from_camera, const std::optional<Pose>& previous,
+                          double max_jump_m);
 
 // Metric: every map plane (observed ones first, with homography and inliers); else this
 // image's planes in image space.

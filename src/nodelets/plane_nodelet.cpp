@@ -14,11 +14,13 @@
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
 
+#include "callback_guard.h"
+#include "camera_info_check.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
-#include "plane_params.h"
+#include "ros_params.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -42,48 +44,58 @@ class PlaneNodelet : public nodelet::Nodelet {
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
-    params_ = readPipelineParams(pnh, getName());
+    guard_.setLogger(getName());
+    PlaneNodeParams node;
+    readParams(pnh, planeNodeParamTable(), node, getName());
+    params_ = node.pipeline;
     pipeline_ = std::make_unique<PlanePipeline>(params_);
-    pnh.param<std::string>("map_frame", map_frame_, "map");
-    pnh.param<std::string>("odom_frame", odom_frame_, "");
-    pnh.param("publish_tf", publish_tf_, true);
-    pnh.param<std::string>("image_transport", transport_, "raw");
+    map_frame_ = node.map_frame;
+    odom_frame_ = node.odom_frame;
+    publish_tf_ = node.publish_tf;
+    transport_ = node.image_transport;
+    max_odom_jump_m_ = node.max_odom_jump_m;
 
     planes_pub_ = nh.advertise<PlaneArray>("planes", 5);
     markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("plane_markers", 5);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("map_points", 2);
     image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
     // The image is only needed to draw on: subscribe while someone watches the drawing.
-    debug_pub_ = image_transport_->advertise(
-        "debug_image", 1, [this](const image_transport::SingleSubscriberPublisher&) { connect(); },
-        [this](const image_transport::SingleSubscriberPublisher&) { connect(); });
+    auto connect = guard_.wrap(
+        "connect", [this](const image_transport::SingleSubscriberPublisher&) { this->connect(); });
+    debug_pub_ = image_transport_->advertise("debug_image", 1, connect, connect);
     if (publish_tf_) broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     if (!odom_frame_.empty()) {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
 
-    diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose);
+    diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose, guard_,
+                       node.expected_min_rate_hz, node.expected_max_rate_hz);
 
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens).
-    tracks_sub_ = nh.subscribe("tracks", 5, &PlaneNodelet::onTracks, this);
-    info_sub_ = nh.subscribe("camera_info", 2, &PlaneNodelet::onCameraInfo, this);
-    no_info_timer_ = nh.createTimer(
-        ros::Duration(5.0),
-        [this](const ros::TimerEvent&) {
-          std::lock_guard<std::mutex> lock(mutex_);
-          if (!pipeline_->hasCamera() && frames_ > 0)
-            NODELET_WARN("no usable camera_info after 5 s: image-space planes only");
-        },
-        true);
+    tracks_sub_ =
+        nh.subscribe<Tracks>("tracks", 5, guard_.message("tracks", this, &PlaneNodelet::onTracks));
+    info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>(
+        "camera_info", 2, guard_.message("camera_info", this, &PlaneNodelet::onCameraInfo));
+    no_info_timer_ = nh.createTimer(ros::Duration(5.0),
+                                    guard_.wrap("camera_info timer",
+                                                [this](const ros::TimerEvent&) {
+                                                  std::lock_guard<std::mutex> lock(mutex_);
+                                                  if (!pipeline_->hasCamera() && frames_ > 0)
+                                                    NODELET_WARN(
+                                                        "no usable camera_info after 5 s: "
+                                                        "image-space planes only");
+                                                }),
+                                    true);
   }
 
   void connect() {
     std::lock_guard<std::mutex> lock(connect_mutex_);
     if (debug_pub_.getNumSubscribers() > 0 && !image_sub_) {
-      image_sub_ = image_transport_->subscribe("image", 2, &PlaneNodelet::onImage, this,
-                                               image_transport::TransportHints(transport_));
+      image_sub_ = image_transport_->subscribe(
+          "image", 2, guard_.message("image", this, &PlaneNodelet::onImage), ros::VoidPtr(),
+          image_transport::TransportHints(transport_));
     } else if (debug_pub_.getNumSubscribers() == 0 && image_sub_) {
       image_sub_.shutdown();
       std::lock_guard<std::mutex> state(mutex_);
@@ -100,8 +112,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
     cv::Matx33d K;
     cv::Mat D;
-    const std::string error = fromCameraInfo(*msg, K, D);
+    std::string error = fromCameraInfo(*msg, K, D);
     std::lock_guard<std::mutex> lock(mutex_);
+    if (error.empty()) error = pipeline_->setCamera(K, D);
     if (!error.empty()) {
       ++dropped_info_;
       NODELET_WARN_THROTTLE(10.0, "camera_info rejected: %s; image-space planes only",
@@ -109,7 +122,6 @@ class PlaneNodelet : public nodelet::Nodelet {
       return;
     }
     info_size_ = cv::Size(static_cast<int>(msg->width), static_cast<int>(msg->height));
-    pipeline_->setCamera(K, D);
   }
 
   std::optional<Pose> odometry(const std_msgs::Header& header) {
@@ -117,7 +129,19 @@ class PlaneNodelet : public nodelet::Nodelet {
     try {
       // Never wait in a callback: take what tf has for this stamp or go visual.
       const auto tf = tf_buffer_->lookupTransform(odom_frame_, header.frame_id, header.stamp);
-      return fromTransformMsg(tf.transform);
+      const Pose odom = fromTransformMsg(tf.transform);
+      // tf2 rejects NaN but not infinity; a driver glitch can also jump far in one step.
+      std::lock_guard<std::mutex> lock(mutex_);
+      const std::string error = odometryError(odom, last_odom_, max_odom_jump_m_);
+      last_odom_ = odom;
+      if (!error.empty()) {
+        ++refused_odom_;
+        NODELET_WARN_THROTTLE(5.0, "odometry %s -> %s at %.3f refused (%s): visual pose used",
+                              odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
+                              error.c_str());
+        return {};
+      }
+      return odom;
     } catch (const tf2::TransformException& e) {
       NODELET_WARN_THROTTLE(10.0, "no %s -> %s transform at %.3f (%s): visual pose only",
                             odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
@@ -144,6 +168,20 @@ class PlaneNodelet : public nodelet::Nodelet {
     std::optional<geometry_msgs::TransformStamped> tf;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      // An empty frame_id names no camera: only a named change or a size change counts.
+      const bool other_frame = !msg->header.frame_id.empty() && !last_frame_id_.empty() &&
+                               msg->header.frame_id != last_frame_id_;
+      if (!last_tracks_size_.empty() && (other_frame || frame.size != last_tracks_size_)) {
+        ++camera_switches_;
+        NODELET_WARN_THROTTLE(5.0,
+                              "tracks changed camera ('%s' %dx%d -> '%s' %dx%d): one camera "
+                              "per tracks topic, or the planes of neither are found",
+                              last_frame_id_.c_str(), last_tracks_size_.width,
+                              last_tracks_size_.height, msg->header.frame_id.c_str(),
+                              frame.size.width, frame.size.height);
+      }
+      if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
+      last_tracks_size_ = frame.size;
       if (!info_size_.empty() && info_size_ != frame.size)
         NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",
                               info_size_.width, info_size_.height, frame.size.width,
@@ -217,10 +255,19 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const bool dropped = dropped_ > 0 || dropped_info_ > 0;
+    const long exceptions = guard_.count();
+    const bool warn = dropped_ > 0 || dropped_info_ > 0 || refused_odom_ > 0 ||
+                      camera_switches_ > 0 || exceptions > 0;
     status.summary(
-        dropped ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
-        status_.empty() ? "no tracks yet" : status_);
+        warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
+        exceptions > 0          ? "exceptions caught"
+        : camera_switches_ > 0 ? "tracks mix cameras"
+        : status_.empty()      ? "no tracks yet"
+                               : status_);
+    status.add("exceptions caught (total)", exceptions);
+    if (exceptions > 0) status.add("last exception", guard_.lastReason());
+    status.add("camera switches (total)", camera_switches_);
+    status.add("odometry refused (total)", refused_odom_);
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
@@ -230,6 +277,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.add("landmarks", pipeline_->poseEstimator()->landmarks().size());
   }
 
+  CallbackGuard guard_;  // first member: the last destroyed
   PipelineParams params_;
   std::unique_ptr<PlanePipeline> pipeline_;
   std::string map_frame_, odom_frame_, transport_;
@@ -253,7 +301,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool reset_markers_ = false;
   PipelineState last_state_ = PipelineState::kNoCamera;
   std::string status_;
-  long frames_ = 0, dropped_ = 0, dropped_info_ = 0;
+  long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0;
+  double max_odom_jump_m_ = 1.0;
+  std::optional<Pose> last_odom_;
+  std::string last_frame_id_;
+  cv::Size last_tracks_size_;
   size_t observed_ = 0;
 };
 

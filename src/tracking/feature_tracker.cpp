@@ -59,10 +59,26 @@ void FeatureTracker::reset() {
   frames_since_search_ = 0;
 }
 
+int minimumImageSide(const TrackerParams& params) {
+  // cv::cornerSubPix asserts unless the image is at least 2 x window + 5 px on each side:
+  // window 3 for new corners, reanchor_window_px for live ones.
+  return 2 * std::max(3, params.reanchor_window_px) + 5;
+}
+
+std::string imageSizeError(const cv::Size& size, const TrackerParams& params) {
+  const int side = minimumImageSide(params);
+  if (size.width >= side && size.height >= side) return {};
+  return "image of " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+         " px is smaller than the " + std::to_string(side) + " px per side the tracker's " +
+         "windows need (reanchor_window_px = " + std::to_string(params.reanchor_window_px) + ")";
+}
+
 const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   if (gray.empty() || gray.type() != CV_8UC1) {
     throw std::invalid_argument("FeatureTracker::process needs a non-empty CV_8UC1 image");
   }
+  if (const std::string error = imageSizeError(gray.size(), params_); !error.empty())
+    throw std::invalid_argument("FeatureTracker::process: " + error);
   if (gray.size() != image_size_) reset();
   image_size_ = gray.size();
   stats_ = TrackerFrameStats();

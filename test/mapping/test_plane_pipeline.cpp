@@ -118,3 +118,26 @@ TEST(PlanePipeline, CameraIntrinsicsAreChecked) {
   pipeline.setCamera(CameraModel().K(), cv::Mat());
   EXPECT_TRUE(pipeline.hasCamera());
 }
+
+// Issue 15, case 3: the same K with 5 then 8 coefficients (a recalibration) made cv::norm
+// assert on different sizes. A change of calibration restarts what depends on it.
+TEST(PlanePipeline, RecalibrationWithAnotherNumberOfCoefficientsRestarts) {
+  const cv::Matx33d K = CameraModel().K();
+  PlanePipeline pipeline;
+  EXPECT_EQ(pipeline.setCamera(K, cv::Mat::zeros(1, 5, CV_64F)), "");
+  const PoseEstimator* first = pipeline.poseEstimator();
+  ASSERT_NE(first, nullptr);
+  EXPECT_EQ(pipeline.setCamera(K, cv::Mat::zeros(1, 5, CV_64F)), "");  // the same: kept
+  EXPECT_EQ(pipeline.setCamera(K, cv::Mat::zeros(1, 8, CV_64F)), "");
+  EXPECT_EQ(pipeline.setCamera(K, cv::Mat::zeros(14, 1, CV_32F)), "");
+  EXPECT_EQ(pipeline.setCamera(K, cv::Mat()), "");
+  EXPECT_TRUE(pipeline.hasCamera());
+  // Lengths OpenCV does not take are refused and the camera is kept (issue 15, case 4).
+  for (int n : {1, 3, 6, 100}) {
+    const std::string error = pipeline.setCamera(K, cv::Mat::zeros(1, n, CV_64F));
+    EXPECT_NE(error.find(std::to_string(n) + " distortion coefficients"), std::string::npos)
+        << error;
+    EXPECT_NE(cameraIntrinsicsError(K, cv::Mat::zeros(1, n, CV_64F)), "");
+  }
+  EXPECT_TRUE(pipeline.hasCamera());
+}

@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -21,6 +22,7 @@
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/geometry/plane_fit.h"
 #include "mono_plane_detection/ros/pose_msg.h"
+#include "support/diagnostics_probe.h"
 #include "support/synthetic_tracks.h"
 #include "support/test_timeouts.h"
 
@@ -372,6 +374,119 @@ TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
   const PlaneArrayConstPtr later = drive(1 / 30.0, 80, 800);
   ASSERT_TRUE(later);
   EXPECT_TRUE(later->metric) << later->status;
+}
+
+
+// Issue 15, cases 2-4: camera_info with D: [] (reshape threw), the same K with 5 then 8
+// then 14 coefficients (cv::norm asserted), D of a length OpenCV does not take (accepted,
+// then undistortPoints asserted on the target's corners). Each killed the manager.
+TEST_F(PlaneNodeletTest, K_CameraInfoDistortionVariants) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long rejected = diagnostics.number("camera_info messages rejected");
+  double offset = 900;
+  auto publishAndDrive = [&](const sensor_msgs::CameraInfo& info) {
+    info_pub_.publish(info);
+    scaledWait(0.5).sleep();
+    offset += 10;
+    return drive(0, 15, offset);  // the target is in view: its corners are undistorted
+  };
+  sensor_msgs::CameraInfo info = cameraInfo(world_->camera);
+  info.D.clear();
+  PlaneArrayConstPtr last = publishAndDrive(info);
+  ASSERT_TRUE(last) << "no answer after D: [] (manager gone?)";
+  EXPECT_NE(last->status, "no camera intrinsics: image-space planes only");
+  for (size_t n : {5, 8, 14}) {
+    info = cameraInfo(world_->camera);
+    info.distortion_model = "rational_polynomial";
+    info.D.resize(n, 0.0);
+    last = publishAndDrive(info);
+    ASSERT_TRUE(last) << "no answer after " << n << " coefficients (manager gone?)";
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("camera_info messages rejected"), rejected);
+  for (size_t n : {1, 3, 6, 100}) {
+    info = cameraInfo(world_->camera);
+    info.D.assign(n, 0.0);
+    last = publishAndDrive(info);
+    ASSERT_TRUE(last) << "no answer after " << n << " coefficients (manager gone?)";
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("camera_info messages rejected"), rejected + 4);
+  EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
+  info_pub_.publish(cameraInfo(world_->camera));  // latched: leave a good one
+}
+
+// Issue 15, case 7: an infinite odometry translation passes tf2; the nodelet published
+// metric: true with a NaN camera pose. A 100 m jump was taken as "tracking (odometry)".
+TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
+  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
+      "planes_odom", 50,
+      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom: planes");
+  tf2_ros::TransformBroadcaster broadcaster;
+  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
+  PlaneArrayConstPtr last;
+  for (int k = 0; k < 96; ++k) {
+    const double t = k / 30.0;
+    TrackFrame f = world_->frame(t);
+    f.stamp += 1500;  // its own time line
+    Pose odom = odom_from_map * world_->truthMapFromCamera(t);
+    if (k == 92) odom.t[0] = std::numeric_limits<double>::infinity();
+    if (k == 94) odom.t[1] += 100;
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(f.stamp);
+    tf.header.frame_id = "odom";
+    tf.child_frame_id = "camera_optical";
+    tf.transform = toTransformMsg(odom);
+    broadcaster.sendTransform(tf);
+    ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    tracks.publish(toTracks(f));
+    last = waitFor(answers, ros::Time(f.stamp).toNSec());
+    ASSERT_TRUE(last) << "image " << k << " not answered (manager gone?)";
+    if (k == 91) EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k == 92 || k == 94) {
+      EXPECT_NE(last->status, "tracking (odometry)") << "image " << k;
+      if (last->metric) {
+        EXPECT_TRUE(std::isfinite(last->camera_pose.position.x)) << "image " << k;
+        EXPECT_TRUE(std::isfinite(last->camera_pose.position.y)) << "image " << k;
+        EXPECT_LT(std::abs(last->camera_pose.position.y), 10.0) << "image " << k;
+      }
+    }
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  // 92 (infinite), 93 (a jump back from infinity), 94 (100 m), 95 (100 m back).
+  EXPECT_GE(diagnostics.number("odometry refused (total)"), 3);
+}
+
+// Issue 15, case 15: two cameras alternating on one tracks topic gave 0 planes silently;
+// now each switch is counted in diagnostics, which go to WARN.
+TEST_F(PlaneNodeletTest, M_TwoCamerasOnOneTracksTopicAreReported) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long before = diagnostics.number("camera switches (total)");
+  ASSERT_GE(before, 0);
+  for (int k = 0; k < 10; ++k) {
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += 2000;
+    TracksPtr msg = toTracks(f);
+    if (k % 2) {
+      msg->header.frame_id = "right_camera";
+      msg->width /= 2;
+      msg->height /= 2;
+      for (auto& u : msg->u) u /= 2;
+      for (auto& v : msg->v) v /= 2;
+    }
+    ASSERT_TRUE(send(msg)) << k;
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_GE(diagnostics.number("camera switches (total)") - before, 9);
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
 }
 
 }  // namespace

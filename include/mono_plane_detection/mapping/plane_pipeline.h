@@ -57,9 +57,10 @@ class PlanePipeline {
  public:
   explicit PlanePipeline(const PipelineParams& params = PipelineParams());
 
-  // Sets the intrinsics (checked by cameraIntrinsicsError first); a change of camera
-  // restarts the metric part.
-  void setCamera(const cv::Matx33d& K, const cv::Mat& distortion);
+  // Sets the intrinsics when cameraIntrinsicsError accepts them (else returns its
+  // reason and changes nothing); a change of calibration (K, or the distortion's values
+  // or number) restarts everything that depends on it: pose, map, image history.
+  std::string setCamera(const cv::Matx33d& K, const cv::Mat& distortion);
   bool hasCamera() const { return pose_.has_value(); }
 
   // Frames must be valid (validateTrackFrame). odom_from_camera: robot odometry, if any.

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <opencv2/core.hpp>
 #include <unordered_map>
 #include <vector>
@@ -85,12 +86,17 @@ std::vector<int> closestClaimWins(const std::vector<int>& claim, const std::vect
 std::vector<int> matchCornersToPoints(const std::vector<cv::Point2f>& corners,
                                       const std::vector<cv::Point2f>& points, double radius_px);
 
+// The smallest image side the tracker's windows fit in (cornerSubPix's limit).
+int minimumImageSide(const TrackerParams& params);
+// Empty when an image of this size can be tracked, else why not (naming the sizes).
+std::string imageSizeError(const cv::Size& size, const TrackerParams& params);
+
 class FeatureTracker {
  public:
   explicit FeatureTracker(const TrackerParams& params = TrackerParams());
 
-  // Processes the next image (CV_8UC1, non-empty; throws std::invalid_argument
-  // otherwise) and returns the new current state. An image of another size than the
+  // Processes the next image (CV_8UC1, imageSizeError empty; throws
+  // std::invalid_argument otherwise) and returns the new current state. An image of another size than the
   // previous one starts over (reset).
   const std::vector<TrackedPoint>& process(const cv::Mat& gray);
 

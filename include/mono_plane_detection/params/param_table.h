@@ -1,0 +1,168 @@
+// One declaration per parameter: a table per Params struct gives each field its name
+// (the ROS parameter and YAML key, '/' for a nested struct), its range, unit and
+// meaning; the default is the struct's own default member initializer. From the table
+// come validate() (core, nodelets, tools, tests), the nodelets' parameter reading and
+// docs/parameters.md (param_table --markdown). ROS-free.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
+#include "mono_plane_detection/tracking/target_detector.h"
+
+namespace mono_plane_detection {
+
+// Where one parameter lives inside a Params object.
+using ParamField = std::variant<int*, double*, bool*, size_t*, unsigned*, std::string*>;
+
+template <class P>
+struct ParamSpec {
+  std::string name;                       // ROS name and YAML key path ("pose/max_jump_m")
+  std::function<ParamField(P&)> field;    // the struct member it sets
+  double min = 0, max = 0;                // inclusive range (numbers only)
+  std::string unit;                       // "px", "m", "s", "deg", "" for counts and ratios
+  std::string description;                // one line for people
+  std::string old_name;                   // accepted with a warning, "" when none
+};
+
+template <class P>
+using ParamTable = std::vector<ParamSpec<P>>;
+
+// The field accessor of a member: field(&TrackerParams::max_features).
+template <class P, class T>
+std::function<ParamField(P&)> field(T P::*member) {
+  return [member](P& p) -> ParamField { return &(p.*member); };
+}
+
+// A sub-struct's table inside its parent's, names prefixed ("pose/" + "max_jump_m").
+template <class P, class Sub>
+void appendNested(ParamTable<P>& table, const std::string& prefix, Sub P::*member,
+                  const ParamTable<Sub>& sub) {
+  for (const ParamSpec<Sub>& s : sub) {
+    ParamSpec<P> spec{prefix + s.name, nullptr, s.min, s.max, s.unit, s.description, ""};
+    auto inner = s.field;
+    spec.field = [member, inner](P& p) { return inner(p.*member); };
+    if (!s.old_name.empty()) spec.old_name = s.old_name;
+    table.push_back(std::move(spec));
+  }
+}
+
+std::string toString(const ParamField& value);
+bool isNumber(const ParamField& value);
+// The value as a double (numbers; bool as 0/1); NaN for strings.
+double numericValue(const ParamField& value);
+
+// Empty when the value is in range, else "NAME = VALUE is out of range [MIN, MAX] UNIT".
+template <class P>
+std::string rangeError(const ParamSpec<P>& spec, const ParamField& value) {
+  if (!isNumber(value)) return {};
+  const double v = numericValue(value);
+  if (std::isfinite(v) && v >= spec.min && v <= spec.max) return {};
+  std::ostringstream why;
+  why << spec.name << " = " << toString(value) << " is out of range [" << spec.min << ", "
+      << spec.max << "]" << (spec.unit.empty() ? "" : " ") << spec.unit;
+  return why.str();
+}
+
+// Puts the default back into every out-of-range field of `params` and returns one
+// message per field ("NAME = VALUE is out of range [MIN, MAX]; using the default D").
+// Defaults are those of a default-constructed P.
+template <class P>
+std::vector<std::string> validate(P& params, const ParamTable<P>& table) {
+  std::vector<std::string> errors;
+  P defaults;
+  for (const ParamSpec<P>& spec : table) {
+    const ParamField value = spec.field(params);
+    std::string error = rangeError(spec, value);
+    if (error.empty()) continue;
+    const ParamField fallback = spec.field(defaults);
+    error += "; using the default " + toString(fallback);
+    std::visit(
+        [&](auto* target) {
+          using T = std::remove_pointer_t<decltype(target)>;
+          *target = *std::get<T*>(fallback);
+        },
+        value);
+    errors.push_back(std::move(error));
+  }
+  return errors;
+}
+
+template <class P>
+const ParamSpec<P>* findParam(const ParamTable<P>& table, const std::string& name) {
+  for (const ParamSpec<P>& spec : table)
+    if (spec.name == name || (!spec.old_name.empty() && spec.old_name == name)) return &spec;
+  return nullptr;
+}
+
+// A Markdown table: name, default, range, unit, meaning.
+template <class P>
+std::string toMarkdown(const ParamTable<P>& table) {
+  std::ostringstream out;
+  out << "| parameter | default | range | unit | meaning |\n|---|---|---|---|---|\n";
+  P defaults;
+  for (const ParamSpec<P>& spec : table) {
+    const ParamField value = spec.field(defaults);
+    std::ostringstream range;
+    if (isNumber(value)) range << spec.min << " .. " << spec.max;
+    out << "| `" << spec.name << "` | " << toString(value) << " | " << range.str() << " | "
+        << spec.unit << " | " << spec.description
+        << (spec.old_name.empty() ? "" : " (was `" + spec.old_name + "`)") << " |\n";
+  }
+  return out.str();
+}
+
+// The nodelets' parameters beyond the core structs (node behaviour, frames, topics).
+struct TrackerNodeParams {
+  TrackerParams tracker;  // names without prefix: max_features, ...
+  TargetParams target;    // target/width_m, ...
+  bool lazy = true;
+  bool detect_target = true;
+  double max_gap_s = 1.0;
+  std::string image_transport = "raw";
+  double expected_min_rate_hz = 5.0;
+  double expected_max_rate_hz = 100.0;
+};
+
+struct PlaneNodeParams {
+  PipelineParams pipeline;  // frame_gap, planes/..., pose/..., map/..., target/...
+  std::string map_frame = "map";
+  std::string odom_frame;
+  bool publish_tf = true;
+  std::string image_transport = "raw";
+  double max_odom_jump_m = 1.0;
+  double expected_min_rate_hz = 5.0;
+  double expected_max_rate_hz = 100.0;
+};
+
+// The tables. Each parameter of the core structs is declared here once.
+const ParamTable<TrackerParams>& trackerParamTable();
+const ParamTable<TargetParams>& targetParamTable();
+const ParamTable<GroupParams>& groupParamTable();
+const ParamTable<PlaneParams>& planeParamTable();
+const ParamTable<TwoViewParams>& twoViewParamTable();
+const ParamTable<PoseParams>& poseParamTable();
+const ParamTable<MapParams>& mapParamTable();
+const ParamTable<PipelineParams>& pipelineParamTable();
+const ParamTable<TrackerNodeParams>& trackerNodeParamTable();
+const ParamTable<PlaneNodeParams>& planeNodeParamTable();
+
+// docs/parameters.md: both nodelets' tables (generated; test_param_table checks the
+// committed file is up to date).
+std::string parametersMarkdown();
+
+// validate() with the checks that tie two parameters together (rate window order).
+std::vector<std::string> validate(TrackerNodeParams& params);
+std::vector<std::string> validate(PlaneNodeParams& params);
+std::vector<std::string> validate(TrackerParams& params);
+std::vector<std::string> validate(PipelineParams& params);
+
+}  // namespace mono_plane_detection

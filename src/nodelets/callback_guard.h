@@ -1,0 +1,79 @@
+// The one place per nodelet where "no exception leaves a callback" is enforced: every
+// subscription, timer and connect callback is wrapped; an exception (std::exception or
+// anything else) is caught, logged throttled with its reason, counted for diagnostics,
+// and the nodelet keeps its state and goes on with the next message.
+#pragma once
+
+#include <ros/console.h>
+
+#include <atomic>
+#include <boost/function.hpp>
+#include <boost/shared_ptr.hpp>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <utility>
+
+namespace mono_plane_detection {
+
+class CallbackGuard {
+ public:
+  explicit CallbackGuard(std::string logger = "") : logger_(std::move(logger)) {}
+  void setLogger(const std::string& logger) { logger_ = logger; }
+
+  // Runs f; never throws.
+  template <class F>
+  void run(const char* callback, F&& f) noexcept {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      caught(callback, e.what());
+    } catch (...) {
+      caught(callback, "an exception of unknown type");
+    }
+  }
+
+  // A guarded callable with f's arguments (timer, connect and message callbacks).
+  template <class F>
+  auto wrap(const char* callback, F f) {
+    return [this, callback, f](const auto&... args) { run(callback, [&] { f(args...); }); };
+  }
+
+  // A guarded message callback of the type roscpp and image_transport subscribe with.
+  template <class M, class Owner>
+  boost::function<void(const boost::shared_ptr<const M>&)> message(
+      const char* callback, Owner* owner, void (Owner::*method)(const boost::shared_ptr<const M>&)) {
+    return wrap(callback, [owner, method](const boost::shared_ptr<const M>& msg) {
+      (owner->*method)(msg);
+    });
+  }
+
+  long count() const { return count_; }
+  std::string lastReason() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_;
+  }
+
+ private:
+  void caught(const char* callback, const char* what) noexcept {
+    try {
+      ++count_;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        last_ = std::string(callback) + ": " + what;
+      }
+      ROS_ERROR_STREAM_THROTTLE_NAMED(5.0, logger_, "exception in the " << callback
+                                                                       << " callback (" << what
+                                                                       << "): message dropped, "
+                                                                          "state kept");
+    } catch (...) {  // logging itself failed (out of memory): nothing more to do
+    }
+  }
+
+  std::string logger_;
+  std::atomic<long> count_{0};
+  mutable std::mutex mutex_;
+  std::string last_;
+};
+
+}  // namespace mono_plane_detection

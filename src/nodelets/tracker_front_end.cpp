@@ -1,0 +1,189 @@
+#include "tracker_front_end.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "camera_info_check.h"
+
+namespace mono_plane_detection {
+namespace {
+
+TracksPtr toMessage(const std_msgs::Header& header, const cv::Size& size,
+                    const std::vector<TrackedPoint>& points, bool searched) {
+  TracksPtr msg(new Tracks);
+  msg->header = header;
+  msg->width = size.width;
+  msg->height = size.height;
+  msg->searched = searched;
+  const size_t n = points.size();
+  msg->id.reserve(n);
+  msg->u.reserve(n);
+  msg->v.reserve(n);
+  msg->prev_index.reserve(n);
+  msg->flags.reserve(n);
+  msg->age.reserve(n);
+  for (const auto& p : points) {
+    msg->id.push_back(p.id);
+    msg->u.push_back(p.uv.x);
+    msg->v.push_back(p.uv.y);
+    msg->prev_index.push_back(p.prev_index);
+    msg->flags.push_back((p.is_new ? Tracks::FLAG_NEW : 0) |
+                         (p.is_tracked ? Tracks::FLAG_TRACKED : 0) |
+                         (p.is_reidentified ? Tracks::FLAG_REIDENTIFIED : 0) |
+                         (p.is_target_corner ? Tracks::FLAG_TARGET_CORNER : 0));
+    msg->age.push_back(p.age);
+  }
+  return msg;
+}
+
+std::string seconds(uint64_t ns) {
+  std::ostringstream out;
+  out.precision(3);
+  out << std::fixed << static_cast<double>(ns) * 1e-9;
+  return out.str();
+}
+
+}  // namespace
+
+long GapCounter::add(int64_t interval_ns) {
+  if (interval_ns <= 0) return 0;
+  recent_.push_back({interval_ns, 0});
+  while (recent_.size() > 64) recent_.pop_front();
+  if (recent_.size() < 4) return 0;
+  // The period: the second smallest recent interval (one short outlier does not set it).
+  // A consumer slower than the stream sees consecutive images only now and then (when
+  // its queue catches up), so earlier intervals are counted again against the newest
+  // period; what was counted before is never taken back.
+  std::vector<int64_t> sorted;
+  for (const auto& r : recent_) sorted.push_back(r.first);
+  std::nth_element(sorted.begin(), sorted.begin() + 1, sorted.end());
+  const double period = static_cast<double>(sorted[1]);
+  long added = 0;
+  for (auto& [interval, counted] : recent_) {
+    const double periods = static_cast<double>(interval) / period;
+    const long missing = periods > 1.5 ? std::lround(periods) - 1 : 0;
+    if (missing > counted) {
+      added += missing - counted;
+      counted = missing;
+    }
+  }
+  return added;
+}
+
+TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
+    : params_(params), tracker_(params.tracker), target_startup_(params.target) {
+  validate(params_);  // callers have reported the errors; never run on bad values
+  tracker_ = FeatureTracker(params_.tracker);
+  target_startup_ = TargetStartup(params_.target);
+}
+
+std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) {
+  const std::string error = cameraInfoError(info);
+  info_size_ = error.empty() ? cv::Size(static_cast<int>(info.width), static_cast<int>(info.height))
+                             : cv::Size();
+  return error;
+}
+
+void TrackerFrontEnd::reset() {
+  tracker_.reset();
+  target_startup_.reset();
+  last_stamp_ns_ = 0;
+  last_size_ = cv::Size();
+  last_frame_id_.clear();
+  gaps_.reset();
+}
+
+TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
+  TrackerOutput out;
+  out.grey = toGrey(msg);
+  if (!out.grey.image) {
+    ++counts_.dropped;
+    out.dropped = out.grey.error;
+    out.dropped_is_error = true;
+    return out;
+  }
+  const cv::Mat& image = out.grey.image->image;
+  if (std::string error = imageSizeError(image.size(), params_.tracker); !error.empty()) {
+    ++counts_.dropped;
+    out.dropped = error;
+    out.dropped_is_error = true;
+    return out;
+  }
+  // Integer nanoseconds: (a - b) as a ros::Duration throws beyond 2^31 s (a driver with
+  // an uninitialised clock sends secs = 4000000000 after 1.7e9).
+  const uint64_t stamp_ns = msg->header.stamp.toNSec();
+  if (last_stamp_ns_ != 0 && stamp_ns == last_stamp_ns_) {
+    ++counts_.dropped;  // the same image twice (a republisher, a bag with duplicates)
+    out.dropped = "its stamp " + seconds(stamp_ns) + " repeats the previous one";
+    return out;
+  }
+  // An empty frame_id names no camera (a driver that leaves it out): not a switch.
+  const bool other_frame = !msg->header.frame_id.empty() && !last_frame_id_.empty() &&
+                           msg->header.frame_id != last_frame_id_;
+  const bool switched = last_stamp_ns_ != 0 && (other_frame || image.size() != last_size_);
+  if (switched) {
+    ++counts_.camera_switches;
+    std::ostringstream why;
+    why << "the image stream changed camera (frame_id '" << last_frame_id_ << "' " << last_size_.width
+        << "x" << last_size_.height << " -> '" << msg->header.frame_id << "' " << image.cols << "x"
+        << image.rows << "): tracking starts over; one camera per image topic";
+    out.warnings.push_back({"camera switch", why.str()});
+    tracker_.reset();
+    target_startup_.reset();
+    gaps_.reset();
+  } else if (last_stamp_ns_ != 0 && stamp_ns < last_stamp_ns_) {
+    out.warnings.push_back({"backwards", "image stamp " + seconds(stamp_ns) +
+                                             " is before the previous one (" +
+                                             seconds(last_stamp_ns_) +
+                                             "): time went backwards (bag loop?), tracking "
+                                             "starts over"});
+    tracker_.reset();
+    target_startup_.reset();
+    gaps_.reset();
+  } else if (last_stamp_ns_ != 0) {
+    const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
+    if (static_cast<double>(gap_ns) * 1e-9 > params_.max_gap_s) {
+      // After a pause the scene may have moved anywhere: Lucas-Kanade would follow the
+      // old points into the wrong places.
+      out.warnings.push_back({"gap", seconds(gap_ns) + " s without images: tracking lost, "
+                                                       "starting over"});
+      tracker_.reset();
+      target_startup_.reset();
+      gaps_.reset();
+    } else {
+      counts_.missing += gaps_.add(static_cast<int64_t>(gap_ns));
+    }
+  }
+  if (msg->header.frame_id.empty())
+    out.warnings.push_back({"frame_id", "images have an empty frame_id: tf from the plane "
+                                        "nodelet will not name the camera"});
+  last_size_ = image.size();
+  last_stamp_ns_ = stamp_ns;
+  if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
+  if (!info_size_.empty() && info_size_ != image.size()) {
+    std::ostringstream why;
+    why << "camera_info is for " << info_size_.width << "x" << info_size_.height
+        << " images but the image is " << image.cols << "x" << image.rows;
+    out.warnings.push_back({"info size", why.str()});
+  }
+  tracker_.process(image);
+  // Paper II-A: until the start-up target is seen, look for it; its corners become
+  // tracked points flagged as target corners.
+  if (params_.detect_target) {
+    if (const auto target = target_startup_.process(image, tracker_)) {
+      std::ostringstream what;
+      what << "start-up target found (" << std::lround(target->contrast)
+           << " grey levels of contrast)";
+      out.infos.push_back(what.str());
+    }
+  }
+  const TrackerFrameStats& stats = tracker_.lastStats();
+  counts_.searches += stats.searched ? 1 : 0;
+  counts_.lost += stats.lost;
+  counts_.tracked_now = static_cast<int>(tracker_.current().size());
+  out.tracks = toMessage(msg->header, image.size(), tracker_.current(), stats.searched);
+  return out;
+}
+
+}  // namespace mono_plane_detection

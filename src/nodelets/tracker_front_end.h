@@ -1,0 +1,94 @@
+// What the tracker nodelet does with one message, without ROS transport, so that tests
+// and the message fuzz target (test/fuzz/fuzz_messages.cpp) call exactly what the
+// nodelet calls: every input checked before OpenCV sees it, stamps compared in integer
+// nanoseconds (ros::Duration throws beyond 2^31 s), images missing from the stream and
+// a stream mixing cameras counted.
+#pragma once
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "image_input.h"
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/params/param_table.h"
+#include "mono_plane_detection/tracking/target_startup.h"
+
+namespace mono_plane_detection {
+
+// Something to log; `kind` keys the throttling, so one kind never hides another.
+struct LogEvent {
+  std::string kind;
+  std::string text;
+};
+
+struct TrackerOutput {
+  TracksPtr tracks;               // null when the image was dropped
+  std::string dropped;            // why it was dropped (an ERROR or WARN)
+  bool dropped_is_error = false;  // bad input, not a repeat
+  std::vector<LogEvent> warnings;
+  std::vector<std::string> infos;
+  GreyImage grey;  // the image as tracked (for the debug drawing)
+};
+
+struct TrackerCounts {
+  long dropped = 0;          // images refused (bad, too small, repeated stamp)
+  long missing = 0;          // images missing from the stream (stamp gaps)
+  long camera_switches = 0;  // frame_id or size changed from one image to the next
+  long lost = 0;             // points lost, total
+  long searches = 0;         // corner searches, total
+  int tracked_now = 0;
+};
+
+// Counts images missing from a stream by its stamps: the stream's period is the second
+// smallest of the last 64 intervals (images that came in a row), and an interval of k
+// periods (rounded, above 1.5) means k - 1 images never reached us: our subscriber queue
+// dropped them, or the driver did. When the period estimate falls, the remembered
+// intervals are counted again (a saturated tracker sees images in a row only when its
+// queue catches up). Integer nanoseconds, so no stamp overflows. Chosen over header.seq
+// because publishers inside a nodelet manager need not fill seq, and roscpp does not
+// report what a subscriber queue drops. A stream that slows down for good counts as
+// missing images for up to 64 images.
+class GapCounter {
+ public:
+  // Returns the number of images newly found missing.
+  long add(int64_t interval_ns);
+  void reset() { recent_.clear(); }
+
+ private:
+  std::deque<std::pair<int64_t, long>> recent_;  // interval, images counted in it
+};
+
+class TrackerFrontEnd {
+ public:
+  explicit TrackerFrontEnd(const TrackerNodeParams& params = TrackerNodeParams());
+
+  TrackerOutput process(const sensor_msgs::ImageConstPtr& msg);
+  // Kept for its size (checked against the images); the reason when unusable.
+  std::string setCameraInfo(const sensor_msgs::CameraInfo& info);
+  void reset();  // nobody listens: forget everything but the counts
+
+  const TrackerCounts& counts() const { return counts_; }
+  bool hasCameraInfo() const { return !info_size_.empty(); }
+  bool targetFound() const { return target_startup_.found(); }
+  const TrackerNodeParams& params() const { return params_; }
+
+ private:
+  TrackerNodeParams params_;
+  FeatureTracker tracker_;
+  TargetStartup target_startup_;
+  uint64_t last_stamp_ns_ = 0;  // 0: none yet
+  cv::Size last_size_;
+  std::string last_frame_id_;
+  cv::Size info_size_;
+  GapCounter gaps_;
+  TrackerCounts counts_;
+};
+
+}  // namespace mono_plane_detection

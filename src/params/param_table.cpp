@@ -1,0 +1,353 @@
+#include "mono_plane_detection/params/param_table.h"
+
+#include <limits>
+
+namespace mono_plane_detection {
+
+std::string toString(const ParamField& value) {
+  return std::visit(
+      [](auto* v) -> std::string {
+        using T = std::remove_pointer_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, bool>) {
+          return *v ? "true" : "false";
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return "\"" + *v + "\"";
+        } else {
+          std::ostringstream out;
+          out << *v;
+          return out.str();
+        }
+      },
+      value);
+}
+
+bool isNumber(const ParamField& value) {
+  return !std::holds_alternative<bool*>(value) && !std::holds_alternative<std::string*>(value);
+}
+
+double numericValue(const ParamField& value) {
+  return std::visit(
+      [](auto* v) -> double {
+        using T = std::remove_pointer_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, std::string>)
+          return std::numeric_limits<double>::quiet_NaN();
+        else
+          return static_cast<double>(*v);
+      },
+      value);
+}
+
+// Ranges: what the algorithm accepts without an OpenCV assert, bounded above where a
+// larger value only costs time (an LK window of 2001 px took 8 s per image).
+const ParamTable<TrackerParams>& trackerParamTable() {
+  using P = TrackerParams;
+  static const ParamTable<P> table{
+      {"max_features", field(&P::max_features), 1, 5000, "", "corners kept per image (paper: 50)"},
+      {"min_distance_px", field(&P::min_distance_px), 0, 200, "px",
+       "minimum spacing between corners (paper: 15)"},
+      {"quality_level", field(&P::quality_level), 1e-6, 0.999, "",
+       "corner score threshold, fraction of the strongest corner's score"},
+      {"block_size", field(&P::block_size), 1, 31, "px", "corner score neighbourhood"},
+      {"pyramid_levels", field(&P::pyramid_levels), 1, 10, "",
+       "LK pyramid levels including full resolution (paper: 5)"},
+      {"window_size_px", field(&P::window_size_px), 3, 51, "px",
+       "LK window side (paper: 3); the cost grows with its square"},
+      {"max_iterations", field(&P::max_iterations), 1, 100, "", "LK iterations per level"},
+      {"epsilon_px", field(&P::epsilon_px), 1e-6, 10, "px", "LK stops when the step is below this"},
+      {"min_eigen_threshold", field(&P::min_eigen_threshold), 0, 1, "",
+       "LK drops points whose gradient matrix is flatter"},
+      {"redetect_lost_fraction", field(&P::redetect_lost_fraction), 0, 1, "",
+       "search again when this share of the last search's points is lost (paper: 2/3)"},
+      {"redetect_every", field(&P::redetect_every), 1, 100000, "images",
+       "search again at the latest after this many images (paper: 10)"},
+      {"match_radius_px", field(&P::match_radius_px), 0, 100, "px",
+       "a new corner this close to a live point is that point (paper II-D)"},
+      {"forward_backward_check", field(&P::forward_backward_check), 0, 1, "",
+       "track back to the previous image and drop points that do not return"},
+      {"forward_backward_max_px", field(&P::forward_backward_max_px), 0, 100, "px",
+       "allowed round-trip error"},
+      {"reanchor_on_search", field(&P::reanchor_on_search), 0, 1, "",
+       "at each search pull live points back onto their corner (bounds LK drift)"},
+      {"reanchor_window_px", field(&P::reanchor_window_px), 1, 15, "px",
+       "half-size of that cornerSubPix window; images need 2 x this + 5 px per side"},
+      {"reanchor_max_shift_px", field(&P::reanchor_max_shift_px), 0, 100, "px",
+       "larger corrections are not trusted"},
+      {"mask_existing", field(&P::mask_existing), 0, 1, "",
+       "no new corner within min_distance_px of a live point"},
+      {"reidentify", field(&P::reidentify), 0, 1, "",
+       "a lost point found again gets its old id back"},
+      {"reid_memory_frames", field(&P::reid_memory_frames), 0, 100000, "images",
+       "how long a lost point is remembered"},
+      {"reid_max_hamming", field(&P::reid_max_hamming), 0, 256, "bits",
+       "ORB descriptor distance to accept, of 256"},
+      {"reid_ratio", field(&P::reid_ratio), 0, 1, "",
+       "best / second-best descriptor distance must be below this"},
+      {"reid_max_radius_px", field(&P::reid_max_radius_px), 0, 1000, "px",
+       "how far from its expected place a lost point may come back"},
+  };
+  return table;
+}
+
+const ParamTable<TargetParams>& targetParamTable() {
+  using P = TargetParams;
+  static const ParamTable<P> table{
+      {"width_m", field(&P::width_m), 0.01, 10, "m",
+       "start-up target's white rectangle, the longer side", "target_width_m"},
+      {"height_m", field(&P::height_m), 0.01, 10, "m", "its shorter side", "target_height_m"},
+      {"min_area_px", field(&P::min_area_px), 1, 1e8, "px^2", "smaller candidates are ignored"},
+      {"max_aspect_distortion", field(&P::max_aspect_distortion), 1, 100, "",
+       "the image's side ratio may differ from width/height by this factor"},
+      {"min_contrast", field(&P::min_contrast), 0, 255, "grey levels",
+       "between the white inside and the dark ring"},
+      {"min_structure", field(&P::min_structure), 0, 1, "",
+       "share of the inside above / the ring below Otsu's level"},
+      {"max_ring_ratio", field(&P::max_ring_ratio), 0, 1, "",
+       "the dark border's mean over the white inside's mean"},
+  };
+  return table;
+}
+
+const ParamTable<GroupParams>& groupParamTable() {
+  using P = GroupParams;
+  static const ParamTable<P> table{
+      {"max_groups", field(&P::max_groups), 1, 100000, "",
+       "coplanar groups kept per image (bounds the time)", "max_groups"},
+      {"groups_per_point", field(&P::groups_per_point), 1, 1000, "",
+       "fewer points, fewer groups (max_groups still caps)"},
+      {"max_tries", field(&P::max_tries), 1, 10000000, "", "groups tried per image at most",
+       "max_tries"},
+      {"tries_per_point", field(&P::tries_per_point), 1, 100000, "",
+       "fewer points, fewer tries (max_tries still caps)"},
+      {"max_seeds", field(&P::max_seeds), 1, 1000000, "",
+       "seed points with a neighbour list (bounds memory)"},
+      {"neighbours", field(&P::neighbours), 4, 1000, "",
+       "a group is a seed and 4 of its nearest neighbours"},
+      {"min_neighbour_distance_px", field(&P::min_neighbour_distance_px), 0, 100000, "px",
+       "closer neighbours are passed over (invariant noise grows as the group shrinks)"},
+      {"min_shape", field(&P::min_shape), 0, 1, "",
+       "triangle shape below this is collinear (paper IV-A)"},
+      {"invariant_threshold", field(&P::invariant_threshold), 1e-6, 10, "",
+       "five-point invariants equal within this (relative)", "invariant_threshold"},
+      {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable",
+       "group_seed"},
+  };
+  return table;
+}
+
+const ParamTable<PlaneParams>& planeParamTable() {
+  using P = PlaneParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t{
+        {"vote_threshold_px", field(&P::vote_threshold_px), 0.01, 100, "px",
+         "transfer error below which a point votes for a homography (paper: 2)",
+         "vote_threshold_px"},
+        {"min_plane_support", field(&P::min_plane_support), 5, 100000, "",
+         "points a plane needs", "min_plane_support"},
+        {"max_planes", field(&P::max_planes), 1, 1000, "", "planes per image at most",
+         "max_planes"},
+        {"refit_iterations", field(&P::refit_iterations), 0, 100, "",
+         "refit on inliers / recompute inliers rounds"},
+        {"robust_refit", field(&P::robust_refit), 0, 1, "", "Cauchy re-weighting in the refit"},
+        {"merge_fraction", field(&P::merge_fraction), 0, 1, "",
+         "merge two planes when one refit explains this share of each"},
+    };
+    appendNested(t, "groups/", &P::groups, groupParamTable());
+    return t;
+  }();
+  return table;
+}
+
+const ParamTable<TwoViewParams>& twoViewParamTable() {
+  using P = TwoViewParams;
+  static const ParamTable<P> table{
+      {"min_parallax_deg", field(&P::min_parallax_deg), 0.01, 90, "deg",
+       "median parallax before the two-view metric start", "start_parallax_deg"},
+      {"min_inliers", field(&P::min_inliers), 4, 100000, "", "tracks on the target's plane needed"},
+      {"max_error_px", field(&P::max_error_px), 0.01, 100, "px",
+       "homography RANSAC threshold, triangulation check / 2"},
+      {"max_target_error_px", field(&P::max_target_error_px), 0.01, 1000, "px",
+       "target corners transferred by the target's plane"},
+  };
+  return table;
+}
+
+const ParamTable<PoseParams>& poseParamTable() {
+  using P = PoseParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t{
+        {"min_parallax_deg", field(&P::min_parallax_deg), 0.01, 90, "deg",
+         "a track is triangulated once its two rays differ this much", "min_parallax_deg"},
+        {"retriangulate_factor", field(&P::retriangulate_factor), 1, 100, "",
+         "and again each time its parallax grows by this factor"},
+        {"max_reprojection_px", field(&P::max_reprojection_px), 0.01, 100, "px",
+         "PnP inlier threshold and triangulation check", "max_reprojection_px"},
+        {"min_pnp_points", field(&P::min_pnp_points), 6, 100000, "",
+         "mapped points needed to place the camera without the target", "min_pnp_points"},
+        {"min_inlier_share", field(&P::min_inlier_share), 0, 1, "",
+         "of the landmarks in view, else the PnP pose is refused"},
+        {"max_jump_m", field(&P::max_jump_m), 0.001, 1000, "m",
+         "a PnP pose further than this from the last one is refused"},
+        {"min_depth_m", field(&P::min_depth_m), 0, 1000, "m",
+         "triangulated points must be this far in front of both views"},
+        {"max_landmarks", field(&P::max_landmarks), 1, 10000000, "",
+         "least recently seen 3D points dropped beyond this", "max_landmarks"},
+    };
+    appendNested(t, "two_view/", &P::two_view, twoViewParamTable());
+    return t;
+  }();
+  return table;
+}
+
+const ParamTable<MapParams>& mapParamTable() {
+  using P = MapParams;
+  static const ParamTable<P> table{
+      {"max_residual_m", field(&P::max_residual_m), 1e-4, 10, "m",
+       "a 3D point belongs to a plane within this distance", "plane_max_residual_m"},
+      {"min_points", field(&P::min_points), 3, 100000, "",
+       "3D points needed to put a plane into the map", "plane_min_points"},
+      {"min_share", field(&P::min_share), 0, 1, "",
+       "and this share of the image plane's 3D points", "plane_min_share"},
+      {"max_angle_deg", field(&P::max_angle_deg), 0, 90, "deg",
+       "an observation joins a mapped plane within this angle", "associate_max_angle_deg"},
+      {"max_offset_m", field(&P::max_offset_m), 0, 100, "m",
+       "and this distance (also the merge rule)", "associate_max_offset_m"},
+      {"min_shared_ids", field(&P::min_shared_ids), 0, 1, "",
+       "or this share of the observation's tracks already on the plane"},
+      {"confirm_observations", field(&P::confirm_observations), 1, 10000, "",
+       "a plane is confirmed after this many images", "confirm_observations"},
+      {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",
+       "unconfirmed planes unseen for this long are removed", "tentative_timeout_s"},
+      {"fade_time_s", field(&P::fade_time_s), 1e-3, 1e6, "s",
+       "confidence decays as exp(-unseen / fade_time_s)", "fade_time_s"},
+      {"max_planes", field(&P::max_planes), 1, 10000, "",
+       "the least confident plane is removed beyond this", "max_map_planes"},
+      {"max_points_per_plane", field(&P::max_points_per_plane), 3, 1000000, "",
+       "least recently seen points of a plane dropped beyond this", "max_points_per_plane"},
+  };
+  return table;
+}
+
+const ParamTable<PipelineParams>& pipelineParamTable() {
+  using P = PipelineParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t{
+        {"frame_gap", field(&P::frame_gap), 1, 1000, "images",
+         "homographies map the image this many images back to this one"},
+        {"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
+         "a longer pause between tracks messages is a tracking loss"},
+    };
+    appendNested(t, "planes/", &P::planes, planeParamTable());
+    appendNested(t, "pose/", &P::pose, poseParamTable());
+    appendNested(t, "map/", &P::map, mapParamTable());
+    appendNested(t, "target/", &P::target, targetParamTable());
+    return t;
+  }();
+  return table;
+}
+
+const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
+  using P = TrackerNodeParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t;
+    appendNested(t, "", &P::tracker, trackerParamTable());
+    appendNested(t, "target/", &P::target, targetParamTable());
+    t.push_back({"lazy", field(&P::lazy), 0, 1, "",
+                 "subscribe to the image only while tracks or debug_image have listeners"});
+    t.push_back({"detect_target", field(&P::detect_target), 0, 1, "",
+                 "look for the start-up target (paper II-A) until found"});
+    t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
+                 "a longer pause between images is a tracking loss (start over)"});
+    t.push_back({"image_transport", field(&P::image_transport), 0, 0, "",
+                 "image_transport hint for the image"});
+    t.push_back({"expected_min_rate_hz", field(&P::expected_min_rate_hz), 0, 1e6, "Hz",
+                 "diagnostics: an input rate below this is a warning"});
+    t.push_back({"expected_max_rate_hz", field(&P::expected_max_rate_hz), 0, 1e6, "Hz",
+                 "diagnostics: an input rate above this is a warning"});
+    return t;
+  }();
+  return table;
+}
+
+const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
+  using P = PlaneNodeParams;
+  static const ParamTable<P> table = [] {
+    ParamTable<P> t;
+    appendNested(t, "", &P::pipeline, pipelineParamTable());
+    t.push_back({"map_frame", field(&P::map_frame), 0, 0, "", "the start-up target's frame"});
+    t.push_back({"odom_frame", field(&P::odom_frame), 0, 0, "",
+                 "set (e.g. odom) to take the camera pose from tf odom -> camera"});
+    t.push_back({"publish_tf", field(&P::publish_tf), 0, 1, "",
+                 "map -> camera (or map -> odom with odom_frame)"});
+    t.push_back({"image_transport", field(&P::image_transport), 0, 0, "",
+                 "image_transport hint for the debug image's background"});
+    t.push_back({"max_odom_jump_m", field(&P::max_odom_jump_m), 1e-3, 1e6, "m",
+                 "an odometry move larger than this between two tracks messages is refused "
+                 "(the visual pose is used)"});
+    t.push_back({"expected_min_rate_hz", field(&P::expected_min_rate_hz), 0, 1e6, "Hz",
+                 "diagnostics: a tracks rate below this is a warning"});
+    t.push_back({"expected_max_rate_hz", field(&P::expected_max_rate_hz), 0, 1e6, "Hz",
+                 "diagnostics: a tracks rate above this is a warning"});
+    return t;
+  }();
+  return table;
+}
+
+std::string parametersMarkdown() {
+  std::ostringstream out;
+  out << "# Parameters\n\n"
+         "Generated from the parameter tables (`src/params/param_table.cpp`) by\n"
+         "`rosrun mono_plane_detection param_table --markdown > docs/parameters.md`; do not\n"
+         "edit by hand (`test_param_table` fails when this file is out of date).\n\n"
+         "Each parameter is declared once: its default is the Params struct's default member\n"
+         "initializer, its range, unit and meaning are in the table. The ROS name is the\n"
+         "table name in the nodelet's private namespace (a `/` is a nested YAML map:\n"
+         "`map/max_residual_m` is `map: {max_residual_m: ...}`). A value out of range, or of\n"
+         "the wrong type, is an ERROR naming parameter, value and range, and the default is\n"
+         "used. Names of earlier versions (shown as \"was\") still work, with a warning.\n"
+         "Profiles (`config/*_wheeled.yaml`, `config/*_humanoid.yaml`) are overlays of these\n"
+         "names.\n\n"
+         "## TrackerNodelet (`config/tracker.yaml`)\n\n"
+      << toMarkdown(trackerNodeParamTable())
+      << "\n## PlaneNodelet (`config/planes.yaml`)\n\n"
+      << toMarkdown(planeNodeParamTable());
+  return out.str();
+}
+
+namespace {
+
+template <class P>
+void checkRateWindow(P& p, std::vector<std::string>& errors) {
+  if (p.expected_min_rate_hz <= p.expected_max_rate_hz) return;
+  std::ostringstream why;
+  const P d;
+  why << "expected_min_rate_hz = " << p.expected_min_rate_hz << " is above expected_max_rate_hz = "
+      << p.expected_max_rate_hz << "; using the defaults " << d.expected_min_rate_hz << " and "
+      << d.expected_max_rate_hz;
+  errors.push_back(why.str());
+  p.expected_min_rate_hz = d.expected_min_rate_hz;
+  p.expected_max_rate_hz = d.expected_max_rate_hz;
+}
+
+}  // namespace
+
+std::vector<std::string> validate(TrackerParams& params) {
+  return validate(params, trackerParamTable());
+}
+
+std::vector<std::string> validate(PipelineParams& params) {
+  return validate(params, pipelineParamTable());
+}
+
+std::vector<std::string> validate(TrackerNodeParams& params) {
+  auto errors = validate(params, trackerNodeParamTable());
+  checkRateWindow(params, errors);
+  return errors;
+}
+
+std::vector<std::string> validate(PlaneNodeParams& params) {
+  auto errors = validate(params, planeNodeParamTable());
+  checkRateWindow(params, errors);
+  return errors;
+}
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,190 @@
+// What the nodelets do with one message, without ROS transport (issue 15): camera_info
+// checks, image stamps beyond 2^31 s, images smaller than the tracker's windows, a
+// stream mixing cameras, images missing from the stream, odometry that is not finite or
+// jumps.
+#include <cv_bridge/cv_bridge.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "../../src/nodelets/camera_info_check.h"
+#include "../../src/nodelets/plane_messages.h"
+#include "../../src/nodelets/tracker_front_end.h"
+#include "mono_plane_detection/sim/synthetic_views.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+sensor_msgs::CameraInfo cameraInfo(std::vector<double> D, const std::string& model = "plumb_bob") {
+  sensor_msgs::CameraInfo info;
+  info.width = 640;
+  info.height = 480;
+  info.K = {500, 0, 320, 0, 500, 240, 0, 0, 1};
+  info.P = {500, 0, 320, 0, 0, 500, 240, 0, 0, 0, 1, 0};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.distortion_model = model;
+  info.D = std::move(D);
+  return info;
+}
+
+sensor_msgs::ImagePtr image(const cv::Mat& grey, uint32_t secs, uint32_t nsecs = 0,
+                            const std::string& frame = "camera") {
+  std_msgs::Header header;
+  header.stamp = ros::Time(secs, nsecs);
+  header.frame_id = frame;
+  return cv_bridge::CvImage(header, "mono8", grey).toImageMsg();
+}
+
+cv::Mat textured(const cv::Size& size) {
+  static const cv::Mat texture = makeCornerTexture({1000, 800}, 7);
+  return texture(cv::Rect(cv::Point(100, 100), size)).clone();
+}
+
+}  // namespace
+
+// Issue 15, case 2: D: [] made cv::Mat::reshape throw.
+TEST(CameraInfoCheck, EmptyDistortionMeansNone) {
+  cv::Matx33d K;
+  cv::Mat D;
+  EXPECT_EQ(fromCameraInfo(cameraInfo({}), K, D), "");
+  EXPECT_TRUE(D.empty());
+  EXPECT_EQ(K(0, 0), 500);
+  EXPECT_EQ(fromCameraInfo(cameraInfo({}, ""), K, D), "");  // no model either
+}
+
+// Issue 15, case 4: lengths OpenCV does not take asserted later in undistortPoints.
+TEST(CameraInfoCheck, DistortionLengthsOpenCvDoesNotTakeAreRefused) {
+  cv::Matx33d K;
+  cv::Mat D;
+  for (size_t n : {1, 3, 6, 100}) {
+    const std::string error = fromCameraInfo(cameraInfo(std::vector<double>(n, 0.01)), K, D);
+    EXPECT_NE(error.find(std::to_string(n) + " distortion coefficients"), std::string::npos)
+        << n << ": " << error;
+  }
+  for (size_t n : {4, 5, 8, 12, 14}) {
+    EXPECT_EQ(fromCameraInfo(cameraInfo(std::vector<double>(n, 0.01), "rational_polynomial"), K, D),
+              "")
+        << n;
+    EXPECT_EQ(D.total(), n);
+    EXPECT_EQ(D.type(), CV_64F);
+  }
+  EXPECT_NE(fromCameraInfo(cameraInfo({0, 0, 0, 0}, "equidistant"), K, D), "");
+  EXPECT_NE(fromCameraInfo(cameraInfo({0, 0, 0, 0, 0}, "kannala"), K, D), "");
+  auto bad = cameraInfo({});
+  bad.P[3] = INFINITY;
+  EXPECT_NE(cameraInfoError(bad).find("P[3]"), std::string::npos);
+  bad = cameraInfo({});
+  bad.K[0] = 0;
+  EXPECT_NE(cameraInfoError(bad), "");
+  bad = cameraInfo({});
+  bad.width = 0;
+  EXPECT_NE(cameraInfoError(bad), "");
+}
+
+// Issue 15, case 1: secs = 4000000000 after 100: ros::Duration threw out of the callback.
+TEST(TrackerFrontEnd, StampsBeyondTwoToThe31SecondsAreCompared) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  EXPECT_TRUE(front.process(image(grey, 100)).tracks);
+  const TrackerOutput out = front.process(image(grey, 4000000000u));
+  ASSERT_TRUE(out.tracks) << out.dropped;
+  ASSERT_FALSE(out.warnings.empty());
+  EXPECT_EQ(out.warnings[0].kind, "gap");  // a pause: tracking starts over
+  const TrackerOutput back = front.process(image(grey, 100, 500));
+  ASSERT_TRUE(back.tracks);
+  EXPECT_EQ(back.warnings[0].kind, "backwards");
+}
+
+// Issue 15, case 6: cornerSubPix asserted on a textured image under 11 px on a side.
+TEST(TrackerFrontEnd, ImagesSmallerThanTheWindowsAreDropped) {
+  TrackerFrontEnd front;
+  uint32_t secs = 10;
+  for (const cv::Size size : {cv::Size(10, 10), cv::Size(640, 6), cv::Size(8, 40)}) {
+    const TrackerOutput out = front.process(image(textured(size), ++secs));
+    EXPECT_FALSE(out.tracks) << size;
+    EXPECT_TRUE(out.dropped_is_error);
+    EXPECT_NE(out.dropped.find("smaller than the 11 px"), std::string::npos) << out.dropped;
+  }
+  EXPECT_EQ(front.counts().dropped, 3);
+  EXPECT_TRUE(front.process(image(textured({11, 11}), ++secs)).tracks);
+  // The limit follows the parameter.
+  TrackerNodeParams params;
+  params.tracker.reanchor_window_px = 10;
+  TrackerFrontEnd wide(params);
+  EXPECT_FALSE(wide.process(image(textured({24, 24}), 1)).tracks);
+  EXPECT_TRUE(wide.process(image(textured({25, 25}), 2)).tracks);
+}
+
+// Issue 15, case 5: out-of-range parameters never reach OpenCV.
+TEST(TrackerFrontEnd, OutOfRangeParametersAreReplacedBeforeTracking) {
+  TrackerNodeParams params;
+  params.tracker.min_distance_px = -5;
+  params.tracker.reanchor_window_px = 1000;
+  params.tracker.window_size_px = 2001;
+  TrackerFrontEnd front(params);
+  EXPECT_EQ(front.params().tracker.reanchor_window_px, 3);
+  const cv::Mat grey = textured({320, 240});
+  for (int k = 0; k < 12; ++k) EXPECT_TRUE(front.process(image(grey, 100 + k)).tracks);
+}
+
+// Issue 15, case 15: two cameras on one topic are reported, not silent.
+TEST(TrackerFrontEnd, StreamMixingCamerasIsCounted) {
+  TrackerFrontEnd front;
+  const cv::Mat a = textured({320, 240}), b = textured({160, 120});
+  for (int k = 0; k < 6; ++k) {
+    const TrackerOutput out =
+        front.process(image(k % 2 ? b : a, 100, k * 33000000, k % 2 ? "right" : "left"));
+    ASSERT_TRUE(out.tracks);
+    if (k > 0) {
+      ASSERT_FALSE(out.warnings.empty());
+      EXPECT_EQ(out.warnings[0].kind, "camera switch");
+    }
+  }
+  EXPECT_EQ(front.counts().camera_switches, 5);
+}
+
+// Issue 15, case 16: images the queue (or the driver) dropped are counted by stamp gaps.
+TEST(TrackerFrontEnd, ImagesMissingFromTheStreamAreCounted) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  long expected_missing = 0;
+  for (int k = 0; k < 58; ++k) {  // the last image, 57, arrives
+    if (k >= 20 && k % 3 != 0) {  // from the 20th on two of three never arrive
+      ++expected_missing;
+      continue;
+    }
+    ASSERT_TRUE(front.process(image(grey, 100, k * 10000000)).tracks);
+  }
+  EXPECT_EQ(front.counts().missing, expected_missing);
+  EXPECT_EQ(front.counts().dropped, 0);
+}
+
+TEST(GapCounter, RegularStreamHasNoGaps) {
+  GapCounter gaps;
+  long missing = 0;
+  for (int k = 0; k < 100; ++k) missing += gaps.add(33333333 + (k % 3) * 1000000);
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(gaps.add(4 * 33333333), 3);
+}
+
+// Issue 15, case 7: an infinite translation passed tf2; a 100 m jump was accepted.
+TEST(OdometryCheck, NonFiniteOrJumpingOdometryIsRefused) {
+  Pose odom;
+  odom.t = {1, 2, 0};
+  EXPECT_EQ(odometryError(odom, std::nullopt, 1.0), "");
+  Pose next = odom;
+  next.t[0] += 0.2;
+  EXPECT_EQ(odometryError(next, odom, 1.0), "");
+  Pose infinite = odom;
+  infinite.t[1] = std::numeric_limits<double>::infinity();
+  EXPECT_NE(odometryError(infinite, odom, 1.0).find("not finite"), std::string::npos);
+  EXPECT_NE(odometryError(infinite, std::nullopt, 1.0), "");
+  Pose far = odom;
+  far.t[0] += 100;
+  EXPECT_NE(odometryError(far, odom, 1.0).find("moved 100 m"), std::string::npos);
+  Pose nan_rotation = odom;
+  nan_rotation.R(0, 0) = std::nan("");
+  EXPECT_NE(odometryError(nan_rotation, odom, 1.0), "");
+}

@@ -1,0 +1,177 @@
+// The parameter tables: defaults in range, validate() names and repairs bad values,
+// docs/parameters.md is what the tables generate, config/*.yaml uses only known names
+// with values in range.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <dirent.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "mono_plane_detection/params/param_table.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+template <class P>
+void expectSound(const ParamTable<P>& table) {
+  std::set<std::string> names;
+  P defaults;
+  for (const auto& spec : table) {
+    EXPECT_TRUE(names.insert(spec.name).second) << "twice: " << spec.name;
+    EXPECT_FALSE(spec.description.empty()) << spec.name;
+    EXPECT_EQ(rangeError(spec, spec.field(defaults)), "") << "default out of its own range";
+    if (isNumber(spec.field(defaults))) EXPECT_LT(spec.min, spec.max) << spec.name;
+  }
+  EXPECT_TRUE(validate(defaults, table).empty());
+}
+
+}  // namespace
+
+TEST(ParamTable, DefaultsAreInRangeAndNamesUnique) {
+  expectSound(trackerParamTable());
+  expectSound(targetParamTable());
+  expectSound(pipelineParamTable());
+  expectSound(trackerNodeParamTable());
+  expectSound(planeNodeParamTable());
+  EXPECT_EQ(trackerNodeParamTable().size(),
+            trackerParamTable().size() + targetParamTable().size() + 6);
+}
+
+TEST(ParamTable, NestedNamesReachTheNestedFields) {
+  PipelineParams p;
+  const auto* spec = findParam(pipelineParamTable(), "map/max_residual_m");
+  ASSERT_NE(spec, nullptr);
+  *std::get<double*>(spec->field(p)) = 0.25;
+  EXPECT_EQ(p.map.max_residual_m, 0.25);
+  spec = findParam(pipelineParamTable(), "planes/groups/seed");
+  ASSERT_NE(spec, nullptr);
+  *std::get<unsigned*>(spec->field(p)) = 7;
+  EXPECT_EQ(p.planes.groups.seed, 7u);
+  // Old flat names find the same entry.
+  EXPECT_EQ(findParam(pipelineParamTable(), "plane_max_residual_m")->name, "map/max_residual_m");
+  EXPECT_EQ(findParam(pipelineParamTable(), "start_parallax_deg")->name,
+            "pose/two_view/min_parallax_deg");
+}
+
+// Issue 15, cases 5 and 8: these values reached OpenCV (assert) or took 8 s per image.
+TEST(ParamTable, ValidateRepairsOutOfRangeValuesAndSaysWhy) {
+  TrackerParams p;
+  p.min_distance_px = -5;
+  p.reanchor_window_px = 1000;
+  p.window_size_px = 2001;
+  p.quality_level = std::nan("");
+  p.max_features = 150;  // valid: kept
+  const auto errors = validate(p);
+  ASSERT_EQ(errors.size(), 4u);
+  EXPECT_EQ(errors[0], "min_distance_px = -5 is out of range [0, 200] px; using the default 15");
+  EXPECT_NE(errors[1].find("quality_level = nan"), std::string::npos) << errors[1];
+  EXPECT_EQ(errors[2], "window_size_px = 2001 is out of range [3, 51] px; using the default 7");
+  EXPECT_EQ(errors[3], "reanchor_window_px = 1000 is out of range [1, 15] px; using the default 3");
+  const TrackerParams d;
+  EXPECT_EQ(p.min_distance_px, d.min_distance_px);
+  EXPECT_EQ(p.reanchor_window_px, d.reanchor_window_px);
+  EXPECT_EQ(p.window_size_px, d.window_size_px);
+  EXPECT_EQ(p.quality_level, d.quality_level);
+  EXPECT_EQ(p.max_features, 150);
+}
+
+TEST(ParamTable, ValidateNestedAndNodeParams) {
+  PlaneNodeParams p;
+  p.pipeline.map.max_planes = 0;
+  p.pipeline.planes.min_plane_support = 4;
+  p.max_odom_jump_m = INFINITY;
+  p.expected_min_rate_hz = 50;
+  p.expected_max_rate_hz = 10;
+  const auto errors = validate(p);
+  ASSERT_EQ(errors.size(), 4u);
+  EXPECT_NE(errors[0].find("planes/min_plane_support = 4"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[1].find("map/max_planes = 0"), std::string::npos) << errors[1];
+  EXPECT_NE(errors[2].find("max_odom_jump_m = inf"), std::string::npos) << errors[2];
+  EXPECT_NE(errors[3].find("expected_min_rate_hz = 50 is above"), std::string::npos);
+  const PlaneNodeParams d;
+  EXPECT_EQ(p.pipeline.map.max_planes, d.pipeline.map.max_planes);
+  EXPECT_EQ(p.expected_min_rate_hz, d.expected_min_rate_hz);
+}
+
+TEST(ParamTable, MarkdownHasOneRowPerParameter) {
+  const std::string md = toMarkdown(trackerParamTable());
+  size_t rows = 0;
+  for (char c : md) rows += c == '\n';
+  EXPECT_EQ(rows, trackerParamTable().size() + 2);
+  EXPECT_NE(md.find("| `window_size_px` | 7 | 3 .. 51 | px |"), std::string::npos) << md;
+}
+
+TEST(ParamTable, CommittedDocsAreUpToDate) {
+  std::ifstream file(std::string(SOURCE_DIR) + "/docs/parameters.md");
+  ASSERT_TRUE(file) << "docs/parameters.md missing";
+  std::stringstream committed;
+  committed << file.rdbuf();
+  EXPECT_EQ(committed.str(), parametersMarkdown())
+      << "docs/parameters.md is out of date: rosrun mono_plane_detection param_table "
+         "--markdown > docs/parameters.md";
+}
+
+namespace {
+
+// Every leaf of a YAML map as "a/b/c" -> node.
+void flatten(const YAML::Node& node, const std::string& prefix,
+             std::vector<std::pair<std::string, YAML::Node>>& out) {
+  for (const auto& kv : node) {
+    const std::string name = prefix + kv.first.as<std::string>();
+    if (kv.second.IsMap())
+      flatten(kv.second, name + "/", out);
+    else
+      out.emplace_back(name, kv.second);
+  }
+}
+
+template <class P>
+void checkConfig(const std::string& path, const ParamTable<P>& table) {
+  SCOPED_TRACE(path);
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  flatten(YAML::LoadFile(path), "", keys);
+  EXPECT_FALSE(keys.empty());
+  for (const auto& [name, value] : keys) {
+    const ParamSpec<P>* spec = findParam(table, name);
+    ASSERT_NE(spec, nullptr) << "unknown parameter " << name;
+    EXPECT_EQ(spec->name, name) << "old name in the config";
+    P params;
+    std::visit(
+        [&, &value = value](auto* field) {
+          using T = std::remove_pointer_t<decltype(field)>;
+          if constexpr (std::is_same_v<T, size_t> || std::is_same_v<T, unsigned>)
+            *field = static_cast<T>(value.template as<double>());
+          else
+            *field = value.template as<T>();
+        },
+        spec->field(params));
+    EXPECT_EQ(rangeError(*spec, spec->field(params)), "");
+  }
+}
+
+}  // namespace
+
+TEST(ParamTable, ConfigFilesUseKnownNamesInRange) {
+  const std::string dir = std::string(SOURCE_DIR) + "/config";
+  DIR* d = opendir(dir.c_str());
+  ASSERT_NE(d, nullptr);
+  int files = 0;
+  while (dirent* e = readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.size() < 5 || name.substr(name.size() - 5) != ".yaml") continue;
+    ++files;
+    if (name.rfind("tracker", 0) == 0)
+      checkConfig(dir + "/" + name, trackerNodeParamTable());
+    else if (name.rfind("planes", 0) == 0)
+      checkConfig(dir + "/" + name, planeNodeParamTable());
+    else
+      ADD_FAILURE() << "config/" << name << ": which nodelet?";
+  }
+  closedir(d);
+  EXPECT_EQ(files, 6);
+}
