@@ -1,36 +1,35 @@
 #!/usr/bin/env bash
-# make fuzz: builds the libFuzzer targets of test/fuzz (clang, -fsanitize=fuzzer,address,
-# undefined) against the core compiled the same way, runs each for FUZZ_SECONDS
-# (default 60) from its seed corpus, and prints executions and crashes per target.
-# Crash inputs land in build/fuzz/crashes/; exit code 1 when any target crashed.
+# make fuzz: builds the libFuzzer targets (CMake option MPD_FUZZ, in build/ws_fuzz: the
+# whole package compiled by clang with -fsanitize=fuzzer-no-link,address,undefined), runs
+# each for FUZZ_SECONDS (default 60) from its seed corpus, and prints executions and
+# crashes per target. Crash inputs land in build/fuzz/crashes/; exit code 1 when any
+# target crashed. FUZZ_TARGETS picks targets (default: all).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=$repo/build/ws_fuzz
 out=$repo/build/fuzz
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-"groups segment_planes correspondence_parser target_detector plane_pipeline"}
-mkdir -p "$out/obj" "$out/crashes"
-CXX=${CXX_FUZZ:-clang++}
-flags=(-std=c++17 -O1 -g -fno-omit-frame-pointer -I"$repo/include" $(pkg-config --cflags opencv4)
-       -I/usr/include/eigen3)
-libs=($(pkg-config --libs opencv4))
+jobs=${JOBS:-2}
+targets=${FUZZ_TARGETS:-"groups segment_planes correspondence_parser target_detector plane_pipeline messages"}
+mkdir -p "$ws/src" "$out/crashes"
+[ -e "$ws/src/mono_plane_detection" ] || ln -sfn "$repo/build/ws/src/mono_plane_detection" "$ws/src/mono_plane_detection"
 
-# The core, instrumented for coverage and sanitizers (rebuilt when a source is newer).
-objects=()
-for src in "$repo"/src/{geometry,tracking,planes,mapping,viz,sim,eval}/*.cpp; do
-  obj=$out/obj/$(basename "${src%.cpp}").o
-  if [ ! -f "$obj" ] || [ "$src" -nt "$obj" ] || [ -n "$(find "$repo/include" -newer "$obj" -print -quit)" ]; then
-    "$CXX" "${flags[@]}" -fsanitize=fuzzer-no-link,address,undefined -c "$src" -o "$obj"
-  fi
-  objects+=("$obj")
-done
+flags="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer"
+source /opt/ros/noetic/setup.bash 2>/dev/null || true
+names=()
+for t in $targets; do names+=("fuzz_$t"); done
+echo "fuzz: building ${names[*]} (log: $ws/build.log)"
+(cd "$ws" && CC=clang CXX=clang++ catkin_make -j"$jobs" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+   -DMPD_FUZZ=ON -DCATKIN_ENABLE_TESTING=OFF -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_C_FLAGS="$flags" \
+   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+   -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" "${names[@]}") \
+  > "$ws/build.log" 2>&1 || { tail -30 "$ws/build.log"; exit 1; }
 
 status=0
 for t in $targets; do
-  bin=$out/fuzz_$t
-  "$CXX" "${flags[@]}" -fsanitize=fuzzer,address,undefined "$repo/test/fuzz/fuzz_$t.cpp" \
-    "${objects[@]}" "${libs[@]}" -o "$bin"
+  bin=$ws/devel/lib/mono_plane_detection/fuzz_$t
   corpus=$out/corpus_$t
-  mkdir -p "$corpus"
+  mkdir -p "$corpus" "$repo/test/fuzz/corpus/$t"
   log=$out/fuzz_$t.log
   if "$bin" "$corpus" "$repo/test/fuzz/corpus/$t" -max_total_time="$seconds" -max_len=4096 \
        -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \

@@ -15,6 +15,7 @@
 #include "../../src/sim/bag/sequence_writer.h"
 #include "mono_plane_detection/PlaneArray.h"
 #include "support/test_timeouts.h"
+#include "support/temp_path.h"
 
 using namespace mono_plane_detection;
 
@@ -27,7 +28,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
   spec.trajectory.name = g_trajectory;
   spec.frames = 300;
   spec.render.noise_sigma = 2;
-  const std::string base = ::testing::TempDir() + "accuracy_" + g_trajectory;
+  const std::string base = tempPath("accuracy_" + g_trajectory);
   writeSequence(spec, base + ".bag", base + ".yaml");
   const GroundTruth truth = loadGroundTruth(base + ".yaml");
 

@@ -11,6 +11,7 @@
 
 #include "../../src/sim/bag/sequence_writer.h"
 #include "support/test_timeouts.h"
+#include "support/temp_path.h"
 
 using namespace mono_plane_detection;
 
@@ -21,8 +22,8 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
   spec.camera.fx = spec.camera.fy = 262.5;
   spec.camera.cx = 159.5;
   spec.camera.cy = 119.5;
-  const std::string bag = std::string(::testing::TempDir()) + "playback.bag";
-  writeSequence(spec, bag, std::string(::testing::TempDir()) + "playback.yaml");
+  const std::string bag = tempPath("playback.bag");
+  writeSequence(spec, bag, tempPath("playback.yaml"));
 
   ros::NodeHandle nh;
   std::vector<double> image_stamps;

@@ -11,12 +11,13 @@
 #include <iterator>
 
 #include "../../src/sim/bag/sequence_writer.h"
+#include "support/temp_path.h"
 
 using namespace mono_plane_detection;
 
 namespace {
 
-std::string temp(const std::string& name) { return std::string(::testing::TempDir()) + name; }
+std::string temp(const std::string& name) { return tempPath(name); }
 
 std::string bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include "support/temp_path.h"
+
 namespace mono_plane_detection {
 
 struct ProgramRun {
@@ -18,7 +20,7 @@ struct ProgramRun {
 };
 
 inline ProgramRun runProgram(const std::string& program, const std::string& args) {
-  const std::string err_path = std::string(::testing::TempDir()) + "program_stderr.txt";
+  const std::string err_path = tempPath("program_stderr.txt");
   FILE* pipe = popen((program + " " + args + " 2>" + err_path).c_str(), "r");
   ProgramRun run{-1, "", ""};
   if (!pipe) return run;
@@ -34,7 +36,7 @@ inline ProgramRun runProgram(const std::string& program, const std::string& args
 }
 
 inline std::string writeTempFile(const std::string& name, const std::string& text) {
-  const std::string path = std::string(::testing::TempDir()) + name;
+  const std::string path = tempPath(name);
   std::ofstream(path) << text;
   return path;
 }

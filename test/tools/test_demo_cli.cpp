@@ -18,7 +18,7 @@ using namespace mono_plane_detection;
 
 namespace {
 
-std::string temp(const std::string& name) { return std::string(::testing::TempDir()) + name; }
+std::string temp(const std::string& name) { return tempPath(name); }
 
 // demo.sh with RESULTS PROFILE FRAMES RVIZ [BAG]; `timeout` turns a hang into exit 124.
 ProgramRun demo(const std::string& profile, const std::string& bag,

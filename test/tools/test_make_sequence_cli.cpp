@@ -13,14 +13,14 @@ bool exists(const std::string& path) { return std::ifstream(path).good(); }
 }  // namespace
 
 TEST(MakeSequenceCli, WritesBagAndGroundTruthNextToIt) {
-  const std::string bag = std::string(::testing::TempDir()) + "cli_seq.bag";
+  const std::string bag = tempPath("cli_seq.bag");
   const ProgramRun r =
       run("--trajectory rotation --frames 3 --width 160 --height 120 --focal 130 "
           "--noise 2 --blur 2 --exposure-swing 0.2 --target floor --out " +
           bag);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(exists(bag));
-  EXPECT_TRUE(exists(std::string(::testing::TempDir()) + "cli_seq.yaml"));
+  EXPECT_TRUE(exists(tempPath("cli_seq.yaml")));
   EXPECT_NE(r.out.find("3 images"), std::string::npos);
   EXPECT_NE(r.out.find("images/s"), std::string::npos);  // rendering speed is reported
 }
@@ -46,7 +46,7 @@ namespace {
 ProgramRun runBounded(const std::string& args) {
   return runProgram(std::string("timeout 30 ") + MAKE_SEQUENCE_PATH, args);
 }
-std::string temp(const std::string& name) { return std::string(::testing::TempDir()) + name; }
+std::string temp(const std::string& name) { return tempPath(name); }
 }  // namespace
 
 // Issue 15 item 13: sizes and counts are bounded with a clear message (the old program
@@ -68,10 +68,10 @@ TEST(MakeSequenceCli, SizesAndCountsAreBounded) {
 // Issue 15 item 13: --out X --yaml X wrote the bag, then the YAML over it, and exited 0.
 TEST(MakeSequenceCli, OutputsNeverOverwriteEachOther) {
   const std::string bag = temp("same.bag");
-  for (const std::string& yaml : {bag, temp("./same.bag"), temp("../") +
-                                                               std::string(::testing::TempDir())
-                                                                   .substr(1) +
-                                                               "same.bag"}) {
+  // The same file spelt three ways: as is, through "./", and through "../<folder>/".
+  const std::string dir = ::testing::TempDir();
+  const std::string name = bag.substr(dir.size());
+  for (const std::string& yaml : {bag, dir + "./" + name, dir + "../" + dir.substr(1) + name}) {
     const ProgramRun r = runBounded("--frames 2 --width 64 --height 48 --quiet --out " + bag +
                                     " --yaml " + yaml);
     EXPECT_EQ(r.code, 2) << yaml << ": " << r.err;
