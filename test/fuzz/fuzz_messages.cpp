@@ -5,6 +5,7 @@
 // nodelets call: TrackerFrontEnd (tracker nodelet), fromCameraInfo + PlanePipeline and
 // toTrackFrame + PlanePipeline (plane nodelet). A last section sets parameters from the
 // bytes and runs validate(): nothing may throw, assert or hang.
+#include <boost/make_shared.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
