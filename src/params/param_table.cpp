@@ -1,5 +1,7 @@
 #include "mono_plane_detection/params/param_table.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <limits>
 
 namespace mono_plane_detection {
@@ -19,6 +21,41 @@ std::string toString(const ParamField& value) {
         }
       },
       value);
+}
+
+std::string setFromText(const ParamField& field, const std::string& text, double min,
+                        double max) {
+  return std::visit(
+      [&](auto* target) -> std::string {
+        using T = std::remove_pointer_t<decltype(target)>;
+        if constexpr (std::is_same_v<T, std::string>) {
+          *target = text;
+          return {};
+        } else if constexpr (std::is_same_v<T, bool>) {
+          if (text == "true" || text == "True" || text == "1") *target = true;
+          else if (text == "false" || text == "False" || text == "0") *target = false;
+          else return "'" + text + "' is not true or false";
+          return {};
+        } else {
+          char* end = nullptr;
+          const double v = std::strtod(text.c_str(), &end);
+          if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+            return "'" + text + "' is not a number";
+          if constexpr (std::is_floating_point_v<T>) {
+            *target = v;
+          } else {
+            // Checked before the cast: a value outside the type would be undefined.
+            if (v != std::floor(v) || v < min || v > max) {
+              std::ostringstream why;
+              why << "'" << text << "' is not a whole number in [" << min << ", " << max << "]";
+              return why.str();
+            }
+            *target = static_cast<T>(v);
+          }
+          return {};
+        }
+      },
+      field);
 }
 
 bool isNumber(const ParamField& value) {
@@ -305,7 +342,9 @@ std::string parametersMarkdown() {
          "the wrong type, is an ERROR naming parameter, value and range, and the default is\n"
          "used. Names of earlier versions (shown as \"was\") still work, with a warning.\n"
          "Profiles (`config/*_wheeled.yaml`, `config/*_humanoid.yaml`) are overlays of these\n"
-         "names.\n\n"
+         "names. The tools read the same files through the same tables: `run_pipeline\n"
+         "--profile P` (default: the trajectory's profile) and `segment_planes --profile P`\n"
+         "(default `none`: the core's defaults; `default` is `config/planes.yaml` alone).\n\n"
          "## TrackerNodelet (`config/tracker.yaml`)\n\n"
       << toMarkdown(trackerNodeParamTable())
       << "\n## PlaneNodelet (`config/planes.yaml`)\n\n"

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli_args.h"
+#include "profile.h"
 #include "mono_plane_detection/sim/camera_trajectory.h"
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
@@ -42,7 +43,8 @@ int main(int argc, char** argv) {
   CameraModel camera;
   RenderOptions render;
   render.noise_sigma = 2;
-  int frames = 300, report_every = 0, loops = 1, frame_gap = 5, features = 50;
+  int frames = 300, report_every = 0, loops = 1, frame_gap = 0, features = 0;
+  std::string profile = "auto";
   double fps = 30;
   unsigned seed = 1;
   cli::Parser cli(
@@ -57,10 +59,15 @@ int main(int argc, char** argv) {
       .number("noise", &render.noise_sigma, 0.0, 255.0, "image noise sigma, grey levels", "SIGMA")
       .integer<unsigned>("seed", &seed, 0, std::numeric_limits<unsigned>::max(),
                          "room textures and humanoid jerks", "S")
-      .integer("frame-gap", &frame_gap, 1, 1000, "frames between the two views of the planes")
+      .text("profile", &profile,
+            "parameters: config/{tracker,planes}.yaml with the overlay of profile P (wheeled, "
+            "humanoid), or a .yaml file over them; auto: the trajectory's profile",
+            "P")
+      .integer("frame-gap", &frame_gap, 0, 1000,
+               "frames between the two views of the planes (0: the profile's)")
       .integer("width", &camera.size.width, 64, 4096, "image width, pixels", "W")
       .integer("height", &camera.size.height, 48, 4096, "image height, pixels", "H")
-      .integer("features", &features, 5, 10000, "the tracker's max_features")
+      .integer("features", &features, 0, 10000, "the tracker's max_features (0: the profile's)")
       .integer("report-every", &report_every, 0, 1000000,
                "print the state every N frames (0: only the end)")
       .integer("loop", &loops, 1, 100000,
@@ -80,19 +87,27 @@ int main(int argc, char** argv) {
   std::vector<TruthPlane> truth = truthPlanes(scene);
   const Pose map_from_world = scene.target.world_from_map.inverse();
 
-  TrackerParams tracker_params;
-  tracker_params.max_features = features;
-  if (trajectory.name == "humanoid") {  // config/tracker_humanoid.yaml
-    tracker_params.pyramid_levels = 6;
-    tracker_params.window_size_px = 15;
+  // The nodelets' settings for this robot, so that a run here is a run there.
+  if (profile == "auto") profile = trajectory.name == "rotation" ? "default" : trajectory.name;
+  TrackerNodeParams tracker_node;
+  PlaneNodeParams plane_node;
+  std::vector<std::string> errors =
+      loadProfile(MPD_CONFIG_DIR, "tracker", profile, trackerNodeParamTable(), tracker_node);
+  for (std::string& e : loadProfile(MPD_CONFIG_DIR, "planes", profile, planeNodeParamTable(), plane_node))
+    errors.push_back(std::move(e));
+  if (!errors.empty()) {
+    for (const std::string& e : errors) std::fprintf(stderr, "run_pipeline: %s\n", e.c_str());
+    return 2;
   }
-  PipelineParams params;
-  params.frame_gap = frame_gap;
+  TrackerParams tracker_params = tracker_node.tracker;
+  if (features > 0) tracker_params.max_features = features;
+  PipelineParams params = plane_node.pipeline;
+  if (frame_gap > 0) params.frame_gap = frame_gap;
 
   using Clock = std::chrono::steady_clock;
-  std::printf("run_pipeline: %s, %d frames x %d loop(s), %dx%d, noise %.1f\n",
-              trajectory.name.c_str(), frames, loops, camera.size.width, camera.size.height,
-              render.noise_sigma);
+  std::printf("run_pipeline: %s, profile %s, %d frames x %d loop(s), %dx%d, noise %.1f\n",
+              trajectory.name.c_str(), profile.c_str(), frames, loops, camera.size.width,
+              camera.size.height, render.noise_sigma);
   FeatureTracker tracker(tracker_params);
   TargetStartup startup;
   PlanePipeline pipeline(params);

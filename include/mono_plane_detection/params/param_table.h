@@ -61,6 +61,12 @@ bool isNumber(const ParamField& value);
 double numericValue(const ParamField& value);
 
 // Empty when the value is in range, else "NAME = VALUE is out of range [MIN, MAX] UNIT".
+// Sets a field from a value written as text (a YAML scalar, a command-line value): the
+// field's type decides how it is read. Empty when set, else why not (not a number, not a
+// whole number in [min, max], not true/false). Ranges of numbers are validate()'s job.
+std::string setFromText(const ParamField& field, const std::string& text, double min,
+                        double max);
+
 template <class P>
 std::string rangeError(const ParamSpec<P>& spec, const ParamField& value) {
   if (!isNumber(value)) return {};

@@ -1,0 +1,89 @@
+// Profiles for the command-line tools: the nodelets' YAML files (config/tracker.yaml,
+// config/planes.yaml) with a robot's overlay on top (config/<nodelet>_<profile>.yaml),
+// read through the same parameter tables as the nodelets, so a tool runs with exactly
+// the settings `roslaunch ... profile:=humanoid` gives.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mono_plane_detection/params/param_table.h"
+
+namespace mono_plane_detection {
+
+// Every leaf of a YAML map as "a/b/c" -> node (the table's nested names).
+inline void flattenYaml(const YAML::Node& node, const std::string& prefix,
+                        std::vector<std::pair<std::string, YAML::Node>>& out) {
+  for (const auto& kv : node) {
+    const std::string name = prefix + kv.first.as<std::string>();
+    if (kv.second.IsMap())
+      flattenYaml(kv.second, name + "/", out);
+    else
+      out.emplace_back(name, kv.second);
+  }
+}
+
+// Sets params from one YAML file through the table; returns one line per problem (file
+// unreadable, unknown name, wrong type, out of range: the default is kept).
+template <class P>
+std::vector<std::string> applyYamlFile(const std::string& path, const ParamTable<P>& table,
+                                       P& params) {
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  try {
+    flattenYaml(YAML::LoadFile(path), "", keys);
+  } catch (const YAML::Exception& e) {
+    return {path + ": " + e.what()};
+  }
+  std::vector<std::string> errors;
+  for (const auto& [name, value] : keys) {
+    const ParamSpec<P>* spec = findParam(table, name);
+    if (!spec) {
+      errors.push_back(path + ": unknown parameter " + name);
+      continue;
+    }
+    const std::string error =
+        value.IsScalar() ? setFromText(spec->field(params), value.Scalar(), spec->min, spec->max)
+                         : "not a single value";
+    if (!error.empty()) errors.push_back(path + ": " + name + ": " + error);
+  }
+  for (const std::string& error : validate(params)) errors.push_back(path + ": " + error);
+  return errors;
+}
+
+// config/<nodelet>.yaml, then config/<nodelet>_<profile>.yaml over it ("default": no
+// overlay; "none": not even the base file, the core's defaults). A profile that is a path
+// to a .yaml file is read over the base file instead of an overlay.
+template <class P>
+std::vector<std::string> loadProfile(const std::string& config_dir, const std::string& nodelet,
+                                     const std::string& profile, const ParamTable<P>& table,
+                                     P& params) {
+  if (profile == "none") return {};
+  const bool is_file = profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
+  std::vector<std::string> errors = applyYamlFile(config_dir + "/" + nodelet + ".yaml", table, params);
+  if (profile == "default" || profile.empty()) return errors;
+  const std::string overlay =
+      is_file ? profile : config_dir + "/" + nodelet + "_" + profile + ".yaml";
+  if (!std::ifstream(overlay)) {
+    errors.push_back("no profile " + overlay);
+    return errors;
+  }
+  for (std::string& e : applyYamlFile(overlay, table, params)) errors.push_back(std::move(e));
+  return errors;
+}
+
+// The value of --profile (or --profile=X) before the parser runs, so that options given
+// on the command line override the profile whatever their order.
+inline std::string profileArgument(int argc, const char* const* argv, const std::string& fallback) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--profile") == 0 && i + 1 < argc) return argv[i + 1];
+    if (std::strncmp(argv[i], "--profile=", 10) == 0) return argv[i] + 10;
+  }
+  return fallback;
+}
+
+}  // namespace mono_plane_detection

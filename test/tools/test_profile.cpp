@@ -1,0 +1,122 @@
+// Profiles for the tools (src/tools/profile.h): the nodelets' YAML files read through the
+// parameter tables. The humanoid profile once reached run_pipeline as 2 of its 6 keys.
+#include "../../src/tools/profile.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "support/temp_path.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+std::string writeYaml(const std::string& name, const std::string& text) {
+  const std::string path = tempPath(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+}  // namespace
+
+TEST(Profile, NestedKeysSetTheirFields) {
+  PlaneNodeParams p;
+  const std::string path =
+      writeYaml("nested.yaml", "frame_gap: 7\nplanes:\n  vote_threshold_px: 3.5\n  groups:\n"
+                               "    max_groups: 42\npublish_tf: false\nmap_frame: world\n");
+  EXPECT_TRUE(applyYamlFile(path, planeNodeParamTable(), p).empty());
+  EXPECT_EQ(p.pipeline.frame_gap, 7);
+  EXPECT_DOUBLE_EQ(p.pipeline.planes.vote_threshold_px, 3.5);
+  EXPECT_EQ(p.pipeline.planes.groups.max_groups, 42);
+  EXPECT_FALSE(p.publish_tf);
+  EXPECT_EQ(p.map_frame, "world");
+}
+
+TEST(Profile, BadValuesAreNamedAndTheDefaultKept) {
+  const PlaneNodeParams defaults;
+  PlaneNodeParams p;
+  const std::string path = writeYaml(
+      "bad.yaml", "frame_gap: 2.5\nplanes:\n  max_planes: many\n  vote_threshold_px: -1\n"
+                  "no_such_thing: 1\npublish_tf: maybe\n");
+  const std::vector<std::string> errors = applyYamlFile(path, planeNodeParamTable(), p);
+  ASSERT_EQ(errors.size(), 5u);
+  std::string all;
+  for (const std::string& e : errors) all += e + "\n";
+  EXPECT_NE(all.find("frame_gap: '2.5' is not a whole number"), std::string::npos) << all;
+  EXPECT_NE(all.find("planes/max_planes: 'many' is not a number"), std::string::npos) << all;
+  EXPECT_NE(all.find("unknown parameter no_such_thing"), std::string::npos) << all;
+  EXPECT_NE(all.find("publish_tf: 'maybe' is not true or false"), std::string::npos) << all;
+  EXPECT_NE(all.find("planes/vote_threshold_px = -1 is out of range"), std::string::npos) << all;
+  EXPECT_EQ(p.pipeline.frame_gap, defaults.pipeline.frame_gap);
+  EXPECT_EQ(p.pipeline.planes.max_planes, defaults.pipeline.planes.max_planes);
+  EXPECT_DOUBLE_EQ(p.pipeline.planes.vote_threshold_px, defaults.pipeline.planes.vote_threshold_px);
+  EXPECT_TRUE(p.publish_tf);
+}
+
+TEST(Profile, UnreadableFileIsAnError) {
+  TrackerNodeParams p;
+  EXPECT_EQ(applyYamlFile("/no/such/file.yaml", trackerNodeParamTable(), p).size(), 1u);
+  EXPECT_EQ(applyYamlFile(writeYaml("broken.yaml", "a: [1, 2\n"), trackerNodeParamTable(), p).size(),
+            1u);
+}
+
+// Every key of config/tracker_humanoid.yaml reaches the tool, over config/tracker.yaml.
+TEST(Profile, HumanoidOverlayGivesAllItsKeys) {
+  TrackerNodeParams p;
+  ASSERT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "tracker", "humanoid",
+                          trackerNodeParamTable(), p)
+                  .empty());
+  EXPECT_EQ(p.tracker.pyramid_levels, 6);
+  EXPECT_EQ(p.tracker.window_size_px, 15);
+  EXPECT_DOUBLE_EQ(p.tracker.match_radius_px, 2.0);
+  EXPECT_DOUBLE_EQ(p.tracker.forward_backward_max_px, 1.5);
+  EXPECT_EQ(p.tracker.redetect_every, 8);
+  EXPECT_EQ(p.tracker.max_features, 150);
+  PlaneNodeParams planes;
+  ASSERT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "humanoid",
+                          planeNodeParamTable(), planes)
+                  .empty());
+  EXPECT_DOUBLE_EQ(planes.pipeline.planes.vote_threshold_px, 2.5);
+}
+
+TEST(Profile, NoneKeepsTheCoreDefaultsAndUnknownProfilesAreNamed) {
+  PlaneNodeParams p;
+  EXPECT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "none",
+                          planeNodeParamTable(), p)
+                  .empty());
+  EXPECT_EQ(p.pipeline.planes.groups.max_groups, PlaneNodeParams().pipeline.planes.groups.max_groups);
+  const std::vector<std::string> errors = loadProfile(
+      std::string(SOURCE_DIR) + "/config", "planes", "tracked_vehicle", planeNodeParamTable(), p);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("no profile"), std::string::npos) << errors[0];
+}
+
+TEST(Profile, ArgumentIsFoundBeforeParsing) {
+  const char* a[] = {"tool", "--threshold", "3", "--profile", "wheeled", "x.txt"};
+  EXPECT_EQ(profileArgument(6, a, "none"), "wheeled");
+  const char* b[] = {"tool", "--profile=humanoid"};
+  EXPECT_EQ(profileArgument(2, b, "none"), "humanoid");
+  const char* c[] = {"tool", "x.txt", "--profile"};  // no value: the parser reports it
+  EXPECT_EQ(profileArgument(3, c, "none"), "none");
+}
+
+TEST(Profile, SetFromTextReadsByTheFieldsType) {
+  int i = 0;
+  double d = 0;
+  bool b = false;
+  size_t z = 0;
+  std::string s;
+  EXPECT_EQ(setFromText(&i, "-3", -10, 10), "");
+  EXPECT_EQ(i, -3);
+  EXPECT_NE(setFromText(&i, "1e10", -10, 10), "");  // outside the range: not cast
+  EXPECT_NE(setFromText(&z, "-1", 0, 100), "");
+  EXPECT_EQ(setFromText(&d, "2.5e-1", 0, 1), "");
+  EXPECT_DOUBLE_EQ(d, 0.25);
+  EXPECT_NE(setFromText(&d, "nan", 0, 1), "");
+  EXPECT_NE(setFromText(&d, "1.0junk", 0, 1), "");
+  EXPECT_EQ(setFromText(&b, "true", 0, 0), "");
+  EXPECT_TRUE(b);
+  EXPECT_EQ(setFromText(&s, "camera_optical", 0, 0), "");
+  EXPECT_EQ(s, "camera_optical");
+}
