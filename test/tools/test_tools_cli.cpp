@@ -3,6 +3,9 @@
 // without a ROS master and without waiting: the one parser of src/tools/cli_args.h.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -63,4 +66,22 @@ TEST(ToolsCli, RunPipelineRefusesZeroFrames) {
   EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
   EXPECT_EQ(run(RUN_PIPELINE_PATH, "--width 100000").code, 2);
   EXPECT_EQ(run(RUN_PIPELINE_PATH, "--seed -1").code, 2);
+}
+
+// docs/tools.md is every tool's --help, so the page cannot drift from the option tables.
+// Regenerate: MPD_WRITE_TOOLS_DOC=1 devel/lib/mono_plane_detection/test_tools_cli
+TEST(ToolsCli, DocsToolsPageIsEveryToolsHelp) {
+  std::string page =
+      "# Command-line tools\n\n"
+      "Generated from each program's `--help` (its option table in `src/tools/`) by\n"
+      "`MPD_WRITE_TOOLS_DOC=1 test_tools_cli`; `test_tools_cli` fails when this page is out\n"
+      "of date. Run them as `rosrun mono_plane_detection PROGRAM`. Every program answers\n"
+      "`--help` with exit 0 and refuses bad usage with exit 2 and the reason.\n";
+  for (const auto& [name, path] : kTools) page += "\n## " + name + "\n\n```\n" + run(path, "--help").out + "```\n";
+  const std::string doc = std::string(SOURCE_DIR) + "/docs/tools.md";
+  if (std::getenv("MPD_WRITE_TOOLS_DOC")) std::ofstream(doc) << page;
+  std::stringstream committed;
+  committed << std::ifstream(doc).rdbuf();
+  EXPECT_EQ(committed.str(), page) << "docs/tools.md is out of date: MPD_WRITE_TOOLS_DOC=1 "
+                                      "devel/lib/mono_plane_detection/test_tools_cli";
 }
