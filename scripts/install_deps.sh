@@ -18,6 +18,7 @@ PACKAGES=(
   python3-geometry-msgs python3-visualization-msgs
   libyaml-cpp-dev libopencv-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
+  libstd-srvs-dev
 )
 
 PACKAGES+=("$@")  # extra packages a target needs (make demo RVIZ=1: rviz)

@@ -273,11 +273,25 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
   static const ParamTable<P> table = [] {
     ParamTable<P> t;
     appendNested(t, "", &P::pipeline, pipelineParamTable());
-    t.push_back({"map_frame", field(&P::map_frame), 0, 0, "", "the start-up target's frame"});
+    t.push_back({"map_frame", field(&P::map_frame), 0, 0, "",
+                 "the map's frame: z up (REP 103), origin at the start-up target"});
     t.push_back({"odom_frame", field(&P::odom_frame), 0, 0, "",
                  "set (e.g. odom) to take the camera pose from tf odom -> camera"});
     t.push_back({"publish_tf", field(&P::publish_tf), 0, 1, "",
-                 "map -> camera (or map -> odom with odom_frame)"});
+                 "tf: map_frame -> odom_frame, odom_frame -> map_frame, or map_frame -> "
+                 "camera_frame (tf_mode)"});
+    t.push_back({"tf_mode", field(&P::tf_mode), 0, 0, "",
+                 "with odom_frame: above_odom (map_frame -> odom_frame), below_odom "
+                 "(odom_frame -> map_frame: another localiser owns the odom frame's parent) "
+                 "or auto (below_odom when odom_frame already has a parent)"});
+    t.push_back({"camera_frame", field(&P::camera_frame), 0, 0, "",
+                 "without odom_frame: the camera estimate's own frame, a child of map_frame "
+                 "(\"\": the tracks' frame_id + _estimate)"});
+    t.push_back({"rectified", field(&P::rectified), 0, 1, "",
+                 "the tracks are of rectified images: camera_info's P, no distortion (also "
+                 "when the image topic is image_rect*)"});
+    t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0, 1e6, "s",
+                 "diagnostics: waiting longer than this for the start-up target is a warning"});
     t.push_back({"image_transport", field(&P::image_transport), 0, 0, "",
                  "image_transport hint for the debug image's background"});
     t.push_back({"max_odom_jump_m", field(&P::max_odom_jump_m), 1e-3, 1e6, "m",

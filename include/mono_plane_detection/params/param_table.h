@@ -134,9 +134,13 @@ struct TrackerNodeParams {
 
 struct PlaneNodeParams {
   PipelineParams pipeline;  // frame_gap, planes/..., pose/..., map/..., target/...
-  std::string map_frame = "map";
+  std::string map_frame = "plane_map";
   std::string odom_frame;
   bool publish_tf = true;
+  std::string tf_mode = "auto";      // auto | above_odom | below_odom (docs/ros_interface.md)
+  std::string camera_frame;          // no odometry: child of map_frame; "" = <tracks frame>_estimate
+  bool rectified = false;            // the tracks are of rectified images (P, no distortion)
+  double target_timeout_s = 30.0;
   std::string image_transport = "raw";
   double max_odom_jump_m = 1.0;
   double expected_min_rate_hz = 5.0;
