@@ -1,0 +1,27 @@
+// Issue 14, item 8: a downstream package built as Noetic builds it (-std=gnu++14) against
+// the exported headers compiles: the package exports the C++17 they need.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+TEST(DownstreamBuild, Gnu14PackageCompilesAgainstTheHeaders) {
+  const std::string dir = ::testing::TempDir() + "mpd_downstream_build";
+  const std::string log = dir + ".log";
+  const std::string command = "rm -rf '" + dir + "' && mkdir -p '" + dir + "' && cd '" + dir +
+                              "' && cmake '" SOURCE_DIR "/test/downstream' -DCMAKE_PREFIX_PATH='" +
+                              DEVEL_PREFIX ";/usr' -DCMAKE_CXX_FLAGS=-std=gnu++14 > '" + log +
+                              "' 2>&1 && make VERBOSE=1 >> '" + log + "' 2>&1";
+  const int status = std::system(command.c_str());
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  ASSERT_EQ(status, 0) << text.str();
+  // It really was built with Noetic's flag, and the export added C++17 after it.
+  const std::string out = text.str();
+  const size_t gnu14 = out.find("-std=gnu++14"), cxx17 = out.find("++17", gnu14);
+  EXPECT_NE(gnu14, std::string::npos);
+  EXPECT_NE(cxx17, std::string::npos);
+}
