@@ -2,6 +2,7 @@
 // map planes, image planes, the camera pose, rviz markers, the map's points, tf and a
 // debug image out. Frames, tf modes and services: docs/ros_interface.md.
 #include <cv_bridge/cv_bridge.h>
+#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
@@ -14,12 +15,14 @@
 
 #include <deque>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
+#include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/SaveMap.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
@@ -89,6 +92,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
+    node_ = node;
+    startReconfigure(pnh);
     reset_srv_ = pnh.advertiseService("reset", &PlaneNodelet::onReset, this);
     save_srv_ = pnh.advertiseService("save_map", &PlaneNodelet::onSaveMap, this);
 
@@ -101,6 +106,57 @@ class PlaneNodelet : public nodelet::Nodelet {
         nh.subscribe<Tracks>("tracks", 5, guard_.message("tracks", this, &PlaneNodelet::onTracks));
     info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>(
         "camera_info", 2, guard_.message("camera_info", this, &PlaneNodelet::onCameraInfo));
+  }
+
+  // dynamic_reconfigure for the parameters read on every image (cfg/Planes.cfg, made
+  // from the table). Its server starts from the parameter server: the values just read
+  // (YAML, nested names) are put there under the flat names first, or it would start
+  // from the .cfg defaults and override them.
+  void startReconfigure(ros::NodeHandle& pnh) {
+    for (const std::string& name : planeRuntimeParamNames()) {
+      const auto* spec = findParam(planeNodeParamTable(), name);
+      const std::string flat = runtimeCfgName(name);
+      cfg_names_[flat] = name;
+      std::visit(
+          [&](auto* v) {
+            using T = std::remove_pointer_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
+              pnh.setParam(flat, *v);
+            else if constexpr (!std::is_same_v<T, std::string>)
+              pnh.setParam(flat, static_cast<int>(*v));
+          },
+          spec->field(node_));
+    }
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<PlanesConfig>>(pnh);
+    reconfigure_->setCallback([this](PlanesConfig& config, uint32_t) {
+      guard_.run("reconfigure", [&] { onReconfigure(config); });
+    });
+  }
+
+  void onReconfigure(const PlanesConfig& config) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    PlaneNodeParams node = node_;
+    for (const auto& description : PlanesConfig::__getParamDescriptions__()) {
+      const auto it = cfg_names_.find(description->name);
+      if (it == cfg_names_.end()) continue;
+      const auto* spec = findParam(planeNodeParamTable(), it->second);
+      boost::any value;
+      description->getValue(config, value);
+      std::visit(
+          [&](auto* v) {
+            using T = std::remove_pointer_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
+              *v = boost::any_cast<T>(value);
+            else if constexpr (!std::is_same_v<T, std::string>)
+              *v = static_cast<T>(boost::any_cast<int>(value));
+          },
+          spec->field(node));
+    }
+    for (const std::string& error : validate(node)) NODELET_ERROR("reconfigure: %s", error.c_str());
+    node_ = node;
+    params_ = node.pipeline;
+    pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
+    ++reconfigures_;
   }
 
   void connect() {
@@ -456,6 +512,7 @@ class PlaneNodelet : public nodelet::Nodelet {
                      : tf_edge_.empty()    ? std::string("nothing published yet")
                                            : tf_edge_);
     status.add("resets (total)", resets_);
+    status.add("reconfigurations (total)", reconfigures_);
     status.add("planes in this image", observed_);
     status.add("planes in the map", pipeline_->map().planes().size());
     if (pipeline_->poseEstimator())
@@ -463,6 +520,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   CallbackGuard guard_;  // first member: the last destroyed
+  PlaneNodeParams node_;  // as read, then as reconfigured
   PipelineParams params_;
   std::unique_ptr<PlanePipeline> pipeline_;
   std::string map_frame_, odom_frame_, camera_frame_, transport_, tf_mode_;
@@ -472,6 +530,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_;
   ros::ServiceServer reset_srv_, save_srv_;
+  std::unique_ptr<dynamic_reconfigure::Server<PlanesConfig>> reconfigure_;
+  std::map<std::string, std::string> cfg_names_;  // .cfg name -> table name
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
   image_transport::Publisher debug_pub_;
   image_transport::Subscriber image_sub_;
@@ -489,7 +549,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
   long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
-       resets_ = 0;
+       resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
   std::optional<Pose> last_odom_;

@@ -1,6 +1,7 @@
 #include "mono_plane_detection/params/param_table.h"
 
 #include <limits>
+#include <stdexcept>
 
 namespace mono_plane_detection {
 
@@ -304,6 +305,77 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
     return t;
   }();
   return table;
+}
+
+const std::vector<std::string>& planeRuntimeParamNames() {
+  // Only what PlanePipeline reads on every image (setPerImageParams): the map, pose and
+  // target parameters are held by objects made once.
+  static const std::vector<std::string> names{
+      "frame_gap",
+      "max_gap_s",
+      "planes/vote_threshold_px",
+      "planes/min_plane_support",
+      "planes/max_planes",
+      "planes/refit_iterations",
+      "planes/robust_refit",
+      "planes/merge_fraction",
+      "planes/groups/max_groups",
+      "planes/groups/max_tries",
+      "planes/groups/min_neighbour_distance_px",
+      "planes/groups/min_shape",
+      "planes/groups/invariant_threshold",
+  };
+  return names;
+}
+
+std::string runtimeCfgName(const std::string& table_name) {
+  std::string name = table_name;
+  for (char& c : name)
+    if (c == '/') c = '_';
+  return name;
+}
+
+std::string dynamicReconfigureCfg() {
+  std::ostringstream out;
+  out << "#!/usr/bin/env python3\n"
+         "# PlaneNodelet's parameters that can change while it runs (read on every image).\n"
+         "# Generated from the parameter table (src/params/param_table.cpp) by\n"
+         "# `rosrun mono_plane_detection param_table --cfg > cfg/Planes.cfg`; do not edit by\n"
+         "# hand (test_planes_cfg fails when this file is out of date). Each name is the\n"
+         "# table's with '/' -> '_' (planes/vote_threshold_px: planes_vote_threshold_px).\n"
+         "PACKAGE = \"mono_plane_detection\"\n\n"
+         "from dynamic_reconfigure.parameter_generator_catkin import ParameterGenerator, "
+         "bool_t, double_t, int_t\n\n"
+         "gen = ParameterGenerator()\n";
+  PlaneNodeParams defaults;
+  for (const std::string& name : planeRuntimeParamNames()) {
+    const ParamSpec<PlaneNodeParams>* spec = findParam(planeNodeParamTable(), name);
+    if (!spec) throw std::logic_error("runtime parameter " + name + " is not in the table");
+    const ParamField value = spec->field(defaults);
+    std::string description = spec->description + (spec->unit.empty() ? "" : " (" + spec->unit + ")");
+    for (char& c : description)
+      if (c == '"') c = '\'';
+    out << "gen.add(\"" << runtimeCfgName(name) << "\", ";
+    std::visit(
+        [&](auto* v) {
+          using T = std::remove_pointer_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, bool>) {
+            out << "bool_t, 0, \"" << description << "\", " << (*v ? "True" : "False");
+          } else if constexpr (std::is_same_v<T, double>) {
+            out << "double_t, 0, \"" << description << "\", " << *v << ", " << spec->min << ", "
+                << spec->max;
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            throw std::logic_error("string parameter " + name + " is not for dynamic_reconfigure");
+          } else {
+            out << "int_t, 0, \"" << description << "\", " << *v << ", "
+                << static_cast<long long>(spec->min) << ", " << static_cast<long long>(spec->max);
+          }
+        },
+        value);
+    out << ")\n";
+  }
+  out << "\nexit(gen.generate(PACKAGE, \"plane_nodelet\", \"Planes\"))\n";
+  return out.str();
 }
 
 std::string parametersMarkdown() {

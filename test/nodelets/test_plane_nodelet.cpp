@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <std_srvs/Empty.h>
 
@@ -579,6 +580,47 @@ TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
   const PlaneArrayConstPtr again = drive(0, 90, 3010);
   ASSERT_TRUE(again);
   EXPECT_TRUE(again->metric) << again->status;
+}
+
+// dynamic_reconfigure: planes_max_planes = 1 caps this image's planes at one from the next
+// image on (two or more before); back to 8, they come back. Diagnostics count both.
+TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
+  auto planesNow = [&](double t0, double offset) {
+    size_t most = 0;
+    for (int k = 0; k < 10; ++k) {
+      const PlaneArrayConstPtr map = drive(t0 + k / 30.0, 1, offset);
+      if (!map) return static_cast<size_t>(1000);
+      const PlaneArrayConstPtr image = waitFor(image_planes_, map->header.stamp.toNSec());
+      if (!image) return static_cast<size_t>(1000);
+      most = std::max(most, image->planes.size());
+    }
+    return most;
+  };
+  auto setMaxPlanes = [&](int n) {
+    dynamic_reconfigure::Reconfigure srv;
+    dynamic_reconfigure::IntParameter p;
+    p.name = "planes_max_planes";
+    p.value = n;
+    srv.request.config.ints.push_back(p);
+    EXPECT_TRUE(ros::service::call("/plane_detector/set_parameters", srv));
+    bool echoed = false;
+    for (const auto& i : srv.response.config.ints)
+      echoed |= i.name == "planes_max_planes" && i.value == n;
+    EXPECT_TRUE(echoed);
+  };
+  const size_t before = planesNow(4.0, 4000);
+  EXPECT_GE(before, 2u);
+  EXPECT_LT(before, 1000u);
+  setMaxPlanes(1);
+  const size_t capped = planesNow(4.5, 4000);
+  EXPECT_EQ(capped, 1u);
+  setMaxPlanes(8);
+  EXPECT_GE(planesNow(5.0, 4000), 2u);
+  std::printf("image planes: %zu, with planes_max_planes 1: %zu\n", before, capped);
+  // The YAML's nested values were the server's start, not the .cfg defaults.
+  int max_groups = 0;
+  EXPECT_TRUE(ros::param::get("/plane_detector/planes_groups_max_groups", max_groups));
+  EXPECT_EQ(max_groups, 100);  // config/planes.yaml (the .cfg default is 300)
 }
 
 }  // namespace

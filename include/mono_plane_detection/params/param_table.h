@@ -159,6 +159,15 @@ const ParamTable<PipelineParams>& pipelineParamTable();
 const ParamTable<TrackerNodeParams>& trackerNodeParamTable();
 const ParamTable<PlaneNodeParams>& planeNodeParamTable();
 
+// The PlaneNodelet parameters that can change while it runs (dynamic_reconfigure): read
+// anew on every image. Table names; in cfg/Planes.cfg each is the name with '/' -> '_'.
+const std::vector<std::string>& planeRuntimeParamNames();
+std::string runtimeCfgName(const std::string& table_name);
+
+// cfg/Planes.cfg (dynamic_reconfigure), generated from the table for those parameters
+// (param_table --cfg; test_planes_cfg checks the committed file is up to date).
+std::string dynamicReconfigureCfg();
+
 // docs/parameters.md: both nodelets' tables (generated; test_param_table checks the
 // committed file is up to date).
 std::string parametersMarkdown();
