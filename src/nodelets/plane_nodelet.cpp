@@ -203,8 +203,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       last_odom_.reset();
       last_planes_.reset();
       tf_conflict_.clear();
-      resolved_tf_mode_.clear();
-      tf_published_ = false;
+      resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
       waiting_since_ = -1;
       ++resets_;
       NODELET_INFO("reset: the map and the camera pose start over");
@@ -279,7 +278,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (existing != parent)
         return "frame '" + child + "' already has the parent '" + existing +
                "' on tf: publishing " + parent + " -> " + child + " would give it a second parent";
-      if (!tf_published_)
+      if (!published_edges_.count(parent + " -> " + child))
         return "'" + parent + " -> " + child + "' is already on tf from another broadcaster";
     }
     std::string up = parent;  // no loop: the child must not be above the parent
@@ -344,8 +343,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                     tf_conflict_.c_str());
       return {};
     }
-    tf_published_ = true;
     tf_edge_ = parent + " -> " + child;
+    published_edges_.insert(tf_edge_);
     return toTransform(parent_from_child, header.stamp, parent, child);
   }
 
@@ -560,7 +559,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string tf_edge_;           // what is published
-  bool tf_published_ = false;
+  std::set<std::string> published_edges_;  // links this nodelet has put on tf
 };
 
 }  // namespace mono_plane_detection

@@ -580,6 +580,13 @@ TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
   const PlaneArrayConstPtr again = drive(0, 90, 3010);
   ASSERT_TRUE(again);
   EXPECT_TRUE(again->metric) << again->status;
+  // Its own earlier tf link is no conflict after the reset.
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  drive(90 / 30.0, 40, 3010);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_EQ(diagnostics.value("tf"), "plane_map -> camera_optical_estimate");
+  EXPECT_GE(diagnostics.number("resets (total)"), 2);
 }
 
 // dynamic_reconfigure: planes_max_planes = 1 caps this image's planes at one from the next
