@@ -479,11 +479,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     const bool lost = state_ == PipelineState::kLost;
     if (!tf_conflict_.empty())
       status.summary(DiagnosticStatus::ERROR, "tf conflict: " + tf_conflict_);
-    else if (exceptions > 0)
-      status.summary(DiagnosticStatus::WARN, "exceptions caught");
-    else if (camera_switches_ > 0)
-      status.summary(DiagnosticStatus::WARN, "tracks mix cameras");
-    else if (no_camera)
+    else if (no_camera)  // the present state first, then what happened since the start
       status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
     else if (lost)
       status.summary(DiagnosticStatus::WARN, "tracking lost: " + status_);
@@ -491,6 +487,10 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.summary(DiagnosticStatus::WARN,
                      "start-up target not seen for " + std::to_string(static_cast<int>(waited_s_)) +
                          " s");
+    else if (exceptions > 0)
+      status.summary(DiagnosticStatus::WARN, "exceptions caught");
+    else if (camera_switches_ > 0)
+      status.summary(DiagnosticStatus::WARN, "tracks mix cameras");
     else if (dropped_ > 0 || dropped_info_ > 0 || refused_odom_ > 0)
       status.summary(DiagnosticStatus::WARN, status_.empty() ? "input refused" : status_);
     else

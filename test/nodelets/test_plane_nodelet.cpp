@@ -630,6 +630,31 @@ TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
   EXPECT_EQ(max_groups, 100);  // config/planes.yaml (the .cfg default is 300)
 }
 
+// Diagnostics WARN when the start-up target has not been seen for target_timeout_s (30 s
+// of tracks stamps), and OK again once it is.
+TEST_F(PlaneNodeletTest, P_TargetNotSeenIsAWarning) {
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  for (int k = 0; k <= 4; ++k) {  // the room without the target's flags, 10 s apart
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp = 5000 + 10.0 * k;
+    f.target_corner.assign(f.target_corner.size(), false);
+    ASSERT_TRUE(send(toTracks(f)));
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());  // a status made after the last tracks
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN) << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("start-up target not seen for 40 s"), std::string::npos)
+      << diagnostics.message();
+  const PlaneArrayConstPtr seen = drive(0, 3, 5041);
+  ASSERT_TRUE(seen);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.message().find("start-up target not seen"), std::string::npos)
+      << diagnostics.message();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
