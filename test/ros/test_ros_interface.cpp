@@ -1,6 +1,6 @@
 // The pipeline as a robot sees it (issue 14), on real messages through the launch files:
-//  TwoCameras: two cameras in one roscore and one manager (plane_detection.launch twice,
-//    namespaces front and rear), under simulated time; front raw with distortion (K, D),
+//  TwoCameras: cameras in one roscore (plane_detection.launch three times: front and rear
+//    in one manager, side in its own), under simulated time; front raw with distortion (K, D),
 //    rear rectified (image_rect: P, no distortion) -- the same accuracy; diagnostics OK
 //    during the replay and again after a pause.
 //  TfTree: a URDF-like static tree (base_link -> camera_optical) plus odometry (odom ->
@@ -106,21 +106,27 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   ros::Publisher rear_tracks = nh.advertise<Tracks>("/rear/tracks", 20);
   ros::Publisher front_info = nh.advertise<sensor_msgs::CameraInfo>("/front/camera_info", 1, true);
   ros::Publisher rear_info = nh.advertise<sensor_msgs::CameraInfo>("/rear/camera_info", 1, true);
-  Answers front_planes(nh, "/front/planes"), rear_planes(nh, "/rear/planes");
+  ros::Publisher side_tracks = nh.advertise<Tracks>("/side/tracks", 20);
+  ros::Publisher side_info = nh.advertise<sensor_msgs::CameraInfo>("/side/camera_info", 1, true);
+  Answers front_planes(nh, "/front/planes"), rear_planes(nh, "/rear/planes"),
+      side_planes(nh, "/side/planes");
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   front_info.publish(cameraInfo(front.camera, front.camera, "front_optical"));
   // The rear camera's raw calibration (distorted, other K) with the rectified P.
   rear_info.publish(cameraInfo(front.camera, rear.camera, "rear_optical"));
+  side_info.publish(cameraInfo(rear.camera, rear.camera, "side_optical"));
   spinUntil(
       [&] {
         return front_tracks.getNumSubscribers() > 0 && rear_tracks.getNumSubscribers() > 0 &&
-               front_planes.sub.getNumPublishers() > 0 && rear_planes.sub.getNumPublishers() > 0;
+               side_tracks.getNumSubscribers() > 0 && front_planes.sub.getNumPublishers() > 0 &&
+               rear_planes.sub.getNumPublishers() > 0 && side_planes.sub.getNumPublishers() > 0;
       },
       30.0);
   ASSERT_GT(front_tracks.getNumSubscribers(), 0u);
   ASSERT_GT(rear_tracks.getNumSubscribers(), 0u);
-  // Both nodelets in the front camera's manager; the names are the cameras' own.
+  ASSERT_GT(side_tracks.getNumSubscribers(), 0u);
+  // Front and rear in the front camera's manager, side in its own; same names, own namespaces.
   std::vector<std::string> nodes;
   ros::master::getNodes(nodes);
   const std::set<std::string> names(nodes.begin(), nodes.end());
@@ -128,6 +134,10 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   EXPECT_FALSE(names.count("/rear/plane_detection_manager"));
   EXPECT_TRUE(names.count("/front/plane_detector"));
   EXPECT_TRUE(names.count("/rear/plane_detector"));
+  EXPECT_TRUE(names.count("/side/plane_detection_manager"));
+  EXPECT_TRUE(names.count("/side/plane_detector"));
+  EXPECT_TRUE(names.count("/side/tracker"));
+  EXPECT_TRUE(names.count("/front/tracker"));
 
   std::vector<double> front_errors, rear_errors;
   auto play = [&](int from, int to) {
@@ -139,9 +149,11 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
       clock.publish(now);
       front_tracks.publish(toTracks(f, "front_optical"));
       rear_tracks.publish(toTracks(r, "rear_optical"));
+      side_tracks.publish(toTracks(r, "side_optical"));
       const PlaneArrayConstPtr a = front_planes.wait(ros::Time(f.stamp));
       const PlaneArrayConstPtr b = rear_planes.wait(ros::Time(r.stamp));
-      if (!a || !b) return false;
+      const PlaneArrayConstPtr c = side_planes.wait(ros::Time(r.stamp));
+      if (!a || !b || !c) return false;
       if (k >= 150 && a->metric) front_errors.push_back(positionError(*a, front.truthMapFromCamera(t)));
       if (k >= 150 && b->metric) rear_errors.push_back(positionError(*b, rear.truthMapFromCamera(t)));
       ros::WallDuration(1.0 / 60).sleep();  // about 30 Hz with the answers' time
@@ -155,6 +167,9 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   EXPECT_EQ(b->header.frame_id, "rear_map");
   EXPECT_TRUE(a->metric) << a->status;
   EXPECT_TRUE(b->metric) << b->status;
+  const PlaneArrayConstPtr c = side_planes.by_stamp.rbegin()->second;
+  EXPECT_EQ(c->header.frame_id, "side_map");
+  EXPECT_TRUE(c->metric) << c->status;
   double front_worst = 0, rear_worst = 0;
   for (double e : front_errors) front_worst = std::max(front_worst, e);
   for (double e : rear_errors) rear_worst = std::max(rear_worst, e);
