@@ -18,6 +18,8 @@ PACKAGES=(
   python3-geometry-msgs python3-visualization-msgs
   libyaml-cpp-dev libopencv-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
+  libstd-srvs-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 
 PACKAGES+=("$@")  # extra packages a target needs (make demo RVIZ=1: rviz)

@@ -63,6 +63,13 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   return {};
 }
 
+void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap,
+                                      double max_gap_s) {
+  params_.planes = planes;
+  params_.frame_gap = frame_gap;
+  params_.max_gap_s = max_gap_s;
+}
+
 void PlanePipeline::reset() {
   if (pose_) pose_->reset();
   map_.reset();

@@ -4,6 +4,7 @@
 #include <sensor_msgs/distortion_models.h>
 
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 #include <sstream>
 
 #include "mono_plane_detection/mapping/plane_pipeline.h"
@@ -26,11 +27,20 @@ std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
   // Empty D is "no distortion" (simulators, rectified streams), whatever the model says.
   if (!info.D.empty()) {
     namespace dm = sensor_msgs::distortion_models;
-    if (info.distortion_model == dm::EQUIDISTANT)
-      return "distortion model 'equidistant' (fisheye) is not supported yet";
+    if (info.distortion_model == dm::EQUIDISTANT) {
+      if (info.D.size() != 4) {
+        why << "distortion model 'equidistant' takes 4 coefficients (k1..k4), not "
+            << info.D.size();
+        return why.str();
+      }
+      for (double d : info.D)
+        if (!std::isfinite(d)) return "an equidistant coefficient is not finite";
+      const cv::Mat none;
+      return cameraIntrinsicsError(K, none);
+    }
     if (info.distortion_model != dm::PLUMB_BOB && info.distortion_model != dm::RATIONAL_POLYNOMIAL)
       return "distortion model '" + info.distortion_model +
-             "' is not supported (plumb_bob, rational_polynomial)";
+             "' is not supported (plumb_bob, rational_polynomial, equidistant)";
   }
   // 1 x N without copying; an empty vector would make reshape throw (issue 15, case 2).
   const cv::Mat D = info.D.empty() ? cv::Mat()
@@ -43,6 +53,9 @@ std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
 
 std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D) {
   if (std::string error = cameraInfoError(info); !error.empty()) return error;
+  if (!info.D.empty() && info.distortion_model == sensor_msgs::distortion_models::EQUIDISTANT)
+    return "distortion model 'equidistant' is not OpenCV's pinhole model (see "
+           "intrinsicsFromCameraInfo: cv::fisheye)";
   if (info.D.empty()) {
     for (int i = 0; i < 9; ++i) K.val[i] = info.K[i];
     D = cv::Mat();
@@ -59,6 +72,71 @@ std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, 
     return std::string("image_geometry refused it: ") + e.what();
   }
   return {};
+}
+
+std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool rectified,
+                                     CameraIntrinsics& out) {
+  out = CameraIntrinsics();
+  out.rectified = rectified;
+  if (rectified) {
+    // image_geometry: rectified pixels are those of P's left 3x3, without distortion
+    // (D belongs to the raw image the stream was rectified from).
+    std::ostringstream why;
+    if (info.width == 0 || info.height == 0) {
+      why << "image size " << info.width << "x" << info.height << " is empty";
+      return why.str();
+    }
+    for (int i = 0; i < 12; ++i)
+      if (!std::isfinite(info.P[i])) {
+        why << "P[" << i << "] = " << info.P[i] << " is not finite";
+        return why.str();
+      }
+    try {
+      image_geometry::PinholeCameraModel model;
+      model.fromCameraInfo(info);
+      const cv::Matx34d& P = model.projectionMatrix();
+      out.K = cv::Matx33d(P(0, 0), P(0, 1), P(0, 2), P(1, 0), P(1, 1), P(1, 2), P(2, 0), P(2, 1),
+                          P(2, 2));
+    } catch (const std::exception& e) {
+      return std::string("image_geometry refused it: ") + e.what();
+    }
+    if (std::string error = cameraIntrinsicsError(out.K, cv::Mat()); !error.empty())
+      return "P (rectified stream): " + error;
+    return {};
+  }
+  if (std::string error = cameraInfoError(info); !error.empty()) return error;
+  if (!info.D.empty() && info.distortion_model == sensor_msgs::distortion_models::EQUIDISTANT) {
+    for (int i = 0; i < 9; ++i) out.K.val[i] = info.K[i];
+    out.fisheye_D = cv::Mat(1, 4, CV_64F);
+    for (int i = 0; i < 4; ++i) out.fisheye_D.at<double>(0, i) = info.D[i];
+    return {};
+  }
+  return fromCameraInfo(info, out.K, out.D);
+}
+
+bool isRectifiedTopic(const std::string& topic) {
+  const std::string base = topic.substr(topic.find_last_of('/') + 1);
+  return base.rfind("image_rect", 0) == 0;
+}
+
+void undistortFisheye(TrackFrame& frame, const CameraIntrinsics& camera) {
+  if (camera.fisheye_D.empty() || frame.pixels.empty()) return;
+  std::vector<cv::Point2d> pinhole;
+  cv::fisheye::undistortPoints(frame.pixels, pinhole, camera.K, camera.fisheye_D, cv::noArray(),
+                               camera.K);
+  TrackFrame kept = frame;
+  kept.ids.clear();
+  kept.pixels.clear();
+  kept.target_corner.clear();
+  for (size_t i = 0; i < pinhole.size(); ++i) {
+    const cv::Point2d& p = pinhole[i];
+    if (!(p.x >= 0 && p.y >= 0 && p.x <= frame.size.width - 1 && p.y <= frame.size.height - 1))
+      continue;  // beyond the pinhole image (or not finite): no longer a pixel
+    kept.ids.push_back(frame.ids[i]);
+    kept.pixels.push_back(p);
+    kept.target_corner.push_back(frame.target_corner[i]);
+  }
+  frame = std::move(kept);
 }
 
 }  // namespace mono_plane_detection

@@ -1,7 +1,9 @@
 // The one place where a sensor_msgs/CameraInfo is judged before OpenCV sees it: image
 // size, finite K and P, the distortion model (image_geometry's names) and the number of
-// its coefficients OpenCV takes. A later issue extends it to the rectified-P semantics of
-// image_geometry::PinholeCameraModel.
+// its coefficients OpenCV takes; and what image_geometry::PinholeCameraModel says the
+// pixels of a stream mean: a raw image has K and D, a rectified one (image_proc's
+// image_rect) has P and no distortion; equidistant (fisheye) pixels are moved to the
+// pinhole image of the same K with cv::fisheye before the core sees them.
 #pragma once
 
 #include <sensor_msgs/CameraInfo.h>
@@ -9,13 +11,37 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "mono_plane_detection/tracking/track_frame.h"
+
 namespace mono_plane_detection {
 
 // Empty when usable, else one sentence naming the bad field and value.
 std::string cameraInfoError(const sensor_msgs::CameraInfo& info);
 
-// K and D (1 x N, CV_64F; empty D: no distortion) of a usable camera_info (through
-// image_geometry::PinholeCameraModel), or the reason it is not usable.
+// K and D (1 x N, CV_64F; empty D: no distortion) of a usable raw camera_info with
+// OpenCV's pinhole model (through image_geometry::PinholeCameraModel), or the reason it
+// is not usable (equidistant included: intrinsicsFromCameraInfo handles it).
 std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D);
+
+// The camera as the core sees it.
+struct CameraIntrinsics {
+  cv::Matx33d K;      // of the pixels given to the core
+  cv::Mat D;          // OpenCV's model (plumb_bob, rational_polynomial); empty: none
+  cv::Mat fisheye_D;  // equidistant (1 x 4): tracks go through undistortFisheye first
+  bool rectified = false;
+};
+
+// rectified: the stream is rectified (P, no distortion), else raw (K, D). Empty when
+// usable, else one sentence naming what is wrong.
+std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool rectified,
+                                     CameraIntrinsics& out);
+
+// A rectified stream by its topic's name: image_proc calls it image_rect (or image_rect_color).
+bool isRectifiedTopic(const std::string& resolved_image_topic);
+
+// Equidistant cameras: every pixel moved to where the pinhole camera K sees the same ray
+// (cv::fisheye::undistortPoints); points that land outside the image are dropped. No-op
+// for other models.
+void undistortFisheye(TrackFrame& frame, const CameraIntrinsics& camera);
 
 }  // namespace mono_plane_detection

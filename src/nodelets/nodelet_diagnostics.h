@@ -1,18 +1,74 @@
-// The diagnostics both nodelets publish: the input rate (FrequencyStatus, window set by
-// the parameters expected_min_rate_hz / expected_max_rate_hz) and one task of the nodelet's own counts,
-// updated once a second.
+// The diagnostics both nodelets publish: the input rate and one task of the nodelet's
+// own counts, once a second. Both run on wall time: under simulated time (a bag replay)
+// /clock may come late, jump or stop, and diagnostic_updater's FrequencyStatus, which
+// reads ros::Time, then reported 0.03 Hz for a 30 Hz replay. The rate is counted over
+// the last few wall seconds, so a pause shows as "no input" and is forgotten within that
+// window once input comes again.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <diagnostic_updater/update_functions.h>
 #include <ros/ros.h>
 
+#include <deque>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "callback_guard.h"
 
 namespace mono_plane_detection {
+
+// Messages per wall second over a sliding window (a DiagnosticTask).
+class WallRateStatus : public diagnostic_updater::DiagnosticTask {
+ public:
+  WallRateStatus(double min_hz, double max_hz, double window_s = 5.0)
+      : DiagnosticTask("input rate"), min_hz_(min_hz), max_hz_(max_hz), window_s_(window_s) {}
+
+  void tick(const ros::WallTime& now = ros::WallTime::now()) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (started_.isZero()) started_ = now;
+    ticks_.push_back(now);
+    ++total_;
+    trim(now);
+  }
+
+  void run(diagnostic_updater::DiagnosticStatusWrapper& status) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::WallTime now = ros::WallTime::now();
+    trim(now);
+    // Until a whole window has passed since the first message, rate over what there is.
+    const double span =
+        started_.isZero() ? window_s_ : std::min(window_s_, std::max((now - started_).toSec(), 1e-3));
+    const double hz = static_cast<double>(ticks_.size()) / span;
+    if (total_ == 0)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input yet");
+    else if (ticks_.empty())
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input for the last window");
+    else if (hz < min_hz_ && span >= window_s_)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "frequency too low");
+    else if (hz > max_hz_)
+      status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "frequency too high");
+    else
+      status.summary(diagnostic_msgs::DiagnosticStatus::OK, "desired frequency met");
+    status.add("events in window", ticks_.size());
+    status.add("events since startup", total_);
+    status.add("duration of window (s), wall time", span);
+    status.add("actual frequency (Hz)", hz);
+    status.add("minimum acceptable frequency (Hz)", min_hz_);
+    status.add("maximum acceptable frequency (Hz)", max_hz_);
+  }
+
+ private:
+  void trim(const ros::WallTime& now) {
+    while (!ticks_.empty() && (now - ticks_.front()).toSec() > window_s_) ticks_.pop_front();
+  }
+
+  std::mutex mutex_;
+  double min_hz_, max_hz_, window_s_;
+  std::deque<ros::WallTime> ticks_;
+  ros::WallTime started_;
+  long total_ = 0;
+};
 
 class NodeletDiagnostics {
  public:
@@ -21,18 +77,16 @@ class NodeletDiagnostics {
              const std::string& task, Owner* owner,
              void (Owner::*diagnose)(diagnostic_updater::DiagnosticStatusWrapper&),
              CallbackGuard& guard, double min_rate_hz, double max_rate_hz) {
-    min_rate_ = min_rate_hz;
-    max_rate_ = max_rate_hz;
     updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, name);
     updater_->setHardwareID("camera");
-    rate_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
-        diagnostic_updater::FrequencyStatusParam(&min_rate_, &max_rate_, 0.1, 10));
+    rate_ = std::make_unique<WallRateStatus>(min_rate_hz, max_rate_hz);
     updater_->add(*rate_);
     updater_->add(task, owner, diagnose);
-    timer_ = nh.createTimer(ros::Duration(1.0),
-                            guard.wrap("diagnostics timer", [this](const ros::TimerEvent&) {
-                              updater_->update();
-                            }));
+    // force_update: update() compares ros::Time, which a paused or late /clock holds still.
+    timer_ = nh.createWallTimer(ros::WallDuration(1.0),
+                                guard.wrap("diagnostics timer", [this](const ros::WallTimerEvent&) {
+                                  updater_->force_update();
+                                }));
   }
 
   void tick() {
@@ -40,14 +94,14 @@ class NodeletDiagnostics {
   }
 
   ~NodeletDiagnostics() {
+    timer_.stop();
     if (updater_) updater_->broadcast(diagnostic_msgs::DiagnosticStatus::OK, "shutting down");
   }
 
  private:
-  double min_rate_ = 5.0, max_rate_ = 100.0;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
-  std::unique_ptr<diagnostic_updater::FrequencyStatus> rate_;
-  ros::Timer timer_;
+  std::unique_ptr<WallRateStatus> rate_;
+  ros::WallTimer timer_;
 };
 
 }  // namespace mono_plane_detection

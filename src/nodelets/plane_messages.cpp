@@ -6,6 +6,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "mono_plane_detection/ros/map_frame.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 
 namespace mono_plane_detection {
@@ -60,23 +62,12 @@ std::string odometryError(const Pose& odom, const std::optional<Pose>& previous,
 
 namespace {
 
-void fill(PlaneEstimate& out, const MapPlane& plane) {
-  out.id = plane.id;
-  out.metric = true;
-  out.normal.x = plane.normal[0];
-  out.normal.y = plane.normal[1];
-  out.normal.z = plane.normal[2];
-  out.distance = plane.distance;
-  for (const auto& v : plane.polygon) {
-    geometry_msgs::Point p;
-    p.x = v[0];
-    p.y = v[1];
-    p.z = v[2];
-    out.polygon.push_back(p);
-  }
-  out.observations = static_cast<uint32_t>(plane.observations);
-  out.confidence = static_cast<float>(plane.confidence);
-  out.rms_m = static_cast<float>(plane.rms_m);
+geometry_msgs::Point point(const cv::Vec3d& v) {
+  geometry_msgs::Point p;
+  p.x = v[0];
+  p.y = v[1];
+  p.z = v[2];
+  return p;
 }
 
 void fill(PlaneEstimate& out, const ImagePlane& plane) {
@@ -96,63 +87,108 @@ std_msgs::ColorRGBA colourOf(int id, double alpha) {
   return c;
 }
 
-geometry_msgs::Point point(const cv::Vec3d& v) {
-  geometry_msgs::Point p;
-  p.x = v[0];
-  p.y = v[1];
-  p.z = v[2];
-  return p;
-}
-
 }  // namespace
 
-PlaneArrayPtr toPlaneArray(const std_msgs::Header& image_header, const std::string& map_frame,
-                           const PipelineResult& result, const PlaneMap& map) {
+PlaneEstimate toPlaneEstimate(const MapPlane& plane) {
+  PlaneEstimate out;
+  const Pose& ros_from_target = rosMapFromTarget();
+  const RosPlane ros = toRosPlane(plane.normal, plane.distance);
+  out.id = plane.id;
+  out.metric = true;
+  out.normal.x = ros.normal[0];
+  out.normal.y = ros.normal[1];
+  out.normal.z = ros.normal[2];
+  out.d = ros.d;
+  out.label = static_cast<uint8_t>(planeKind(ros.normal));
+  for (const auto& v : plane.polygon) out.polygon.push_back(point(ros_from_target.apply(v)));
+  out.observations = static_cast<uint32_t>(plane.observations);
+  out.confidence = static_cast<float>(plane.confidence);
+  out.rms_m = static_cast<float>(plane.rms_m);
+  return out;
+}
+
+PlaneArrayPtr toMapPlanes(const std_msgs::Header& map_header, const PipelineResult& result,
+                          const PlaneMap& map) {
   PlaneArrayPtr msg(new PlaneArray);
-  msg->header = image_header;
+  msg->header = map_header;
   msg->status = result.status;
   msg->metric = result.pose.has_value() && result.state == PipelineState::kTracking;
   msg->reference_stamp = result.reference_stamp > 0 ? result.reference_stamp : 0.0;
-  if (msg->metric) {
-    msg->header.frame_id = map_frame;
-    std::unordered_map<int, const ImagePlane*> seen;
+  if (msg->metric) msg->camera_pose = toPoseMsg(rosMapFromTarget() * result.pose->map_from_camera);
+  std::unordered_map<int, const ImagePlane*> seen;
+  if (msg->metric)
     for (const ImagePlane& p : result.planes)
       if (p.map_id >= 0) seen.emplace(p.map_id, &p);
-    for (int pass = 0; pass < 2; ++pass)  // observed planes first
-      for (const MapPlane& plane : map.planes()) {
-        const auto it = seen.find(plane.id);
-        if ((it != seen.end()) != (pass == 0)) continue;
-        PlaneEstimate out;
-        fill(out, plane);
-        if (it != seen.end()) {
-          fill(out, *it->second);
-          // Under rotation every plane moves with one homography; report the tracks whose
-          // 3D points the map put on this plane.
-          std::vector<std::uint64_t> on_plane;
-          for (auto id : out.inlier_ids)
-            if (plane.points.count(id)) on_plane.push_back(id);
-          out.inlier_ids.assign(on_plane.begin(), on_plane.end());
-        }
-        msg->planes.push_back(out);
+  for (int pass = 0; pass < 2; ++pass)  // observed planes first
+    for (const MapPlane& plane : map.planes()) {
+      const auto it = seen.find(plane.id);
+      if ((it != seen.end()) != (pass == 0)) continue;
+      PlaneEstimate out = toPlaneEstimate(plane);
+      if (it != seen.end()) {
+        fill(out, *it->second);
+        // Under rotation every plane moves with one homography; report the tracks whose
+        // 3D points the map put on this plane.
+        std::vector<std::uint64_t> on_plane;
+        for (auto id : out.inlier_ids)
+          if (plane.points.count(id)) on_plane.push_back(id);
+        out.inlier_ids.assign(on_plane.begin(), on_plane.end());
       }
-  } else {
-    for (const ImagePlane& p : result.planes) {
-      PlaneEstimate out;
-      out.id = p.id;
-      fill(out, p);
-      out.observations = 1;
       msg->planes.push_back(out);
     }
+  return msg;
+}
+
+PlaneArrayPtr toImagePlanes(const std_msgs::Header& image_header, const PipelineResult& result) {
+  PlaneArrayPtr msg(new PlaneArray);
+  msg->header = image_header;
+  msg->status = result.status;
+  msg->metric = false;  // image space: no pose in this message's frame
+  msg->reference_stamp = result.reference_stamp > 0 ? result.reference_stamp : 0.0;
+  msg->camera_pose.orientation.w = 1;
+  for (const ImagePlane& p : result.planes) {
+    PlaneEstimate out;
+    out.id = p.id;
+    fill(out, p);
+    out.observations = 1;
+    msg->planes.push_back(out);
   }
   return msg;
+}
+
+std::string planesYaml(const PlaneArray& planes) {
+  std::ostringstream out;
+  out.precision(6);
+  out << "# mono_plane_detection map: plane {x : normal . x + d = 0} (shape_msgs/Plane sign), m\n"
+      << "frame_id: " << planes.header.frame_id << "\n"
+      << "stamp: " << std::fixed << planes.header.stamp.toSec() << "\n"
+      << "planes:\n";
+  out.unsetf(std::ios::fixed);
+  static const char* names[] = {"other", "floor", "wall", "ceiling"};
+  for (const PlaneEstimate& p : planes.planes) {
+    if (!p.metric) continue;
+    out << "  - id: " << p.id << "\n"
+        << "    label: " << names[p.label < 4 ? p.label : 0] << "\n"
+        << "    normal: [" << p.normal.x << ", " << p.normal.y << ", " << p.normal.z << "]\n"
+        << "    d: " << p.d << "\n"
+        << "    observations: " << p.observations << "\n"
+        << "    confidence: " << p.confidence << "\n"
+        << "    polygon:\n";
+    for (const auto& v : p.polygon)
+      out << "      - [" << v.x << ", " << v.y << ", " << v.z << "]\n";
+  }
+  return out.str();
 }
 
 visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
                                              std::set<int>& shown) {
   visualization_msgs::MarkerArrayPtr markers(new visualization_msgs::MarkerArray);
   std::set<int> now;
+  const Pose& ros_from_target = rosMapFromTarget();
   for (const MapPlane& plane : map.planes()) {
     if (plane.polygon.size() < 3) continue;
+    const cv::Vec3d normal = ros_from_target.R * plane.normal;
+    std::vector<cv::Vec3d> polygon;
+    for (const auto& v : plane.polygon) polygon.push_back(ros_from_target.apply(v));
     now.insert(plane.id);
     const double alpha = 0.15 + 0.5 * plane.confidence;
     visualization_msgs::Marker surface;
@@ -165,19 +201,19 @@ visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, con
     surface.scale.x = surface.scale.y = surface.scale.z = 1;
     surface.color = colourOf(plane.id, alpha);
     cv::Vec3d centre(0, 0, 0);
-    for (const auto& v : plane.polygon) centre += v;
-    centre /= static_cast<double>(plane.polygon.size());
-    for (size_t k = 0; k < plane.polygon.size(); ++k) {  // a fan from the centre
+    for (const auto& v : polygon) centre += v;
+    centre /= static_cast<double>(polygon.size());
+    for (size_t k = 0; k < polygon.size(); ++k) {  // a fan from the centre
       surface.points.push_back(point(centre));
-      surface.points.push_back(point(plane.polygon[k]));
-      surface.points.push_back(point(plane.polygon[(k + 1) % plane.polygon.size()]));
+      surface.points.push_back(point(polygon[k]));
+      surface.points.push_back(point(polygon[(k + 1) % polygon.size()]));
     }
     markers->markers.push_back(surface);
 
     visualization_msgs::Marker arrow = surface;
     arrow.ns = "normals";
     arrow.type = visualization_msgs::Marker::ARROW;
-    arrow.points = {point(centre), point(centre + 0.3 * plane.normal)};
+    arrow.points = {point(centre), point(centre + 0.3 * normal)};
     arrow.scale.x = 0.02;
     arrow.scale.y = 0.04;
     arrow.scale.z = 0.06;
@@ -188,12 +224,13 @@ visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, con
     label.ns = "labels";
     label.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     label.points.clear();
-    label.pose.position = point(centre + 0.35 * plane.normal);
+    label.pose.position = point(centre + 0.35 * normal);
     label.scale.z = 0.12;
     label.color.r = label.color.g = label.color.b = label.color.a = 1;
     std::ostringstream text;
     text.precision(2);
-    text << std::fixed << "plane " << plane.id << " (" << plane.observations << ")";
+    text << planeKindName(planeKind(normal)) << " " << plane.id << " (" << plane.observations
+         << ")";
     label.text = text.str();
     markers->markers.push_back(label);
   }
@@ -228,11 +265,13 @@ sensor_msgs::PointCloud2Ptr toCloud(const std_msgs::Header& header, const PoseEs
   modifier.resize(count);
   sensor_msgs::PointCloud2Iterator<float> x(*cloud, "x"), y(*cloud, "y"), z(*cloud, "z");
   sensor_msgs::PointCloud2Iterator<uint8_t> r(*cloud, "r"), g(*cloud, "g"), b(*cloud, "b");
+  const Pose& ros_from_target = rosMapFromTarget();
   for (const auto& [id, l] : pose.landmarks()) {
     if (!(l.triangulated || l.fixed)) continue;
-    *x = static_cast<float>(l.position[0]);
-    *y = static_cast<float>(l.position[1]);
-    *z = static_cast<float>(l.position[2]);
+    const cv::Vec3d position = ros_from_target.apply(l.position);
+    *x = static_cast<float>(position[0]);
+    *y = static_cast<float>(position[1]);
+    *z = static_cast<float>(position[2]);
     const auto it = plane_of.find(id);
     const cv::Scalar bgr =
         it != plane_of.end() ? planeColour(it->second) : cv::Scalar(200, 200, 200);

@@ -1,5 +1,6 @@
 // Conversions between the plane stage's ROS messages and the core's types: Tracks in,
-// PlaneArray, rviz markers and the map's point cloud out.
+// PlaneArray, rviz markers and the map's point cloud out. Everything metric leaves in
+// the ROS map frame (ros/map_frame.h: REP 103, z up), never in the core's target frame.
 #pragma once
 
 #include <sensor_msgs/CameraInfo.h>
@@ -24,12 +25,22 @@ TrackFrame toTrackFrame(const Tracks& msg, std::string& error);
 std::string odometryError(const Pose& odom_from_camera, const std::optional<Pose>& previous,
                           double max_jump_m);
 
-// Metric: every map plane (observed ones first, with homography and inliers); else this
-// image's planes in image space.
-PlaneArrayPtr toPlaneArray(const std_msgs::Header& image_header, const std::string& map_frame,
-                           const PipelineResult& result, const PlaneMap& map);
+// The map's planes (observed ones first, with homography and inliers) in the ROS map
+// frame `map_header.frame_id`; the camera pose when this image has one.
+PlaneArrayPtr toMapPlanes(const std_msgs::Header& map_header, const PipelineResult& result,
+                          const PlaneMap& map);
 
-// A translucent polygon, a normal arrow and a label per map plane; DELETE markers for
+// This image's planes in image space (homography, inliers), in the tracks' header.
+PlaneArrayPtr toImagePlanes(const std_msgs::Header& image_header, const PipelineResult& result);
+
+// A map plane as the message gives it (ROS map frame, shape_msgs sign, label).
+PlaneEstimate toPlaneEstimate(const MapPlane& plane);
+
+// Planes as YAML (~save_map): frame, stamp and per plane id, label, normal, d, polygon.
+std::string planesYaml(const PlaneArray& planes);
+
+// A translucent polygon, a normal arrow and a label ("wall 3 (12)") per map plane, in
+// the ROS map frame `header.frame_id`; DELETE markers for
 // planes that were published before and are gone (`shown` is updated).
 visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
                                              std::set<int>& shown);

@@ -1,23 +1,32 @@
 // Thin ROS glue around PlanePipeline: tracks (+ camera_info, optional odometry tf) in;
-// planes, rviz markers, the map's points, map -> camera tf and a debug image out.
+// map planes, image planes, the camera pose, rviz markers, the map's points, tf and a
+// debug image out. Frames, tf modes and services: docs/ros_interface.md.
 #include <cv_bridge/cv_bridge.h>
+#include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <deque>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
-#include "mono_plane_detection/viz/draw_planes.h"
+#include "mono_plane_detection/PlanesConfig.h"
+#include "mono_plane_detection/SaveMap.h"
+#include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
+#include "mono_plane_detection/viz/draw_planes.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
 #include "ros_params.h"
@@ -25,11 +34,10 @@
 namespace mono_plane_detection {
 namespace {
 
-geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child,
-                                            const std_msgs::Header& header,
+geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const ros::Time& stamp,
                                             const std::string& parent, const std::string& child) {
   geometry_msgs::TransformStamped tf;
-  tf.header.stamp = header.stamp;
+  tf.header.stamp = stamp;
   tf.header.frame_id = parent;
   tf.child_frame_id = child;
   tf.transform = toTransformMsg(parent_from_child);
@@ -39,7 +47,6 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child,
 }  // namespace
 
 class PlaneNodelet : public nodelet::Nodelet {
- public:
  private:
   void onInit() override {
     ros::NodeHandle& nh = getNodeHandle();
@@ -51,11 +58,27 @@ class PlaneNodelet : public nodelet::Nodelet {
     pipeline_ = std::make_unique<PlanePipeline>(params_);
     map_frame_ = node.map_frame;
     odom_frame_ = node.odom_frame;
+    camera_frame_ = node.camera_frame;
     publish_tf_ = node.publish_tf;
     transport_ = node.image_transport;
     max_odom_jump_m_ = node.max_odom_jump_m;
+    target_timeout_s_ = node.target_timeout_s;
+    tf_mode_ = node.tf_mode;
+    if (tf_mode_ != "auto" && tf_mode_ != "above_odom" && tf_mode_ != "below_odom") {
+      NODELET_ERROR("parameter tf_mode = '%s' is not auto, above_odom or below_odom; using auto",
+                    tf_mode_.c_str());
+      tf_mode_ = "auto";
+    }
+    // image_proc's rectified stream, or said so: P without distortion (image_geometry).
+    const std::string image_topic = nh.resolveName("image");
+    rectified_ = node.rectified || isRectifiedTopic(image_topic);
+    if (rectified_)
+      NODELET_INFO("rectified images (%s): camera_info's P is used, without distortion",
+                   node.rectified ? "parameter rectified" : image_topic.c_str());
 
     planes_pub_ = nh.advertise<PlaneArray>("planes", 5);
+    image_planes_pub_ = nh.advertise<PlaneArray>("image_planes", 5);
+    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("camera_pose", 5);
     markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("plane_markers", 5);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("map_points", 2);
     image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
@@ -64,10 +87,15 @@ class PlaneNodelet : public nodelet::Nodelet {
         "connect", [this](const image_transport::SingleSubscriberPublisher&) { this->connect(); });
     debug_pub_ = image_transport_->advertise("debug_image", 1, connect, connect);
     if (publish_tf_) broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-    if (!odom_frame_.empty()) {
+    // Also without odometry: what is already on tf is checked before publishing to it.
+    if (publish_tf_ || !odom_frame_.empty()) {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
+    node_ = node;
+    startReconfigure(pnh);
+    reset_srv_ = pnh.advertiseService("reset", &PlaneNodelet::onReset, this);
+    save_srv_ = pnh.advertiseService("save_map", &PlaneNodelet::onSaveMap, this);
 
     diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose, guard_,
                        node.expected_min_rate_hz, node.expected_max_rate_hz);
@@ -78,16 +106,57 @@ class PlaneNodelet : public nodelet::Nodelet {
         nh.subscribe<Tracks>("tracks", 5, guard_.message("tracks", this, &PlaneNodelet::onTracks));
     info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>(
         "camera_info", 2, guard_.message("camera_info", this, &PlaneNodelet::onCameraInfo));
-    no_info_timer_ = nh.createTimer(ros::Duration(5.0),
-                                    guard_.wrap("camera_info timer",
-                                                [this](const ros::TimerEvent&) {
-                                                  std::lock_guard<std::mutex> lock(mutex_);
-                                                  if (!pipeline_->hasCamera() && frames_ > 0)
-                                                    NODELET_WARN(
-                                                        "no usable camera_info after 5 s: "
-                                                        "image-space planes only");
-                                                }),
-                                    true);
+  }
+
+  // dynamic_reconfigure for the parameters read on every image (cfg/Planes.cfg, made
+  // from the table). Its server starts from the parameter server: the values just read
+  // (YAML, nested names) are put there under the flat names first, or it would start
+  // from the .cfg defaults and override them.
+  void startReconfigure(ros::NodeHandle& pnh) {
+    for (const std::string& name : planeRuntimeParamNames()) {
+      const auto* spec = findParam(planeNodeParamTable(), name);
+      const std::string flat = runtimeCfgName(name);
+      cfg_names_[flat] = name;
+      std::visit(
+          [&](auto* v) {
+            using T = std::remove_pointer_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
+              pnh.setParam(flat, *v);
+            else if constexpr (!std::is_same_v<T, std::string>)
+              pnh.setParam(flat, static_cast<int>(*v));
+          },
+          spec->field(node_));
+    }
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<PlanesConfig>>(pnh);
+    reconfigure_->setCallback([this](PlanesConfig& config, uint32_t) {
+      guard_.run("reconfigure", [&] { onReconfigure(config); });
+    });
+  }
+
+  void onReconfigure(const PlanesConfig& config) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    PlaneNodeParams node = node_;
+    for (const auto& description : PlanesConfig::__getParamDescriptions__()) {
+      const auto it = cfg_names_.find(description->name);
+      if (it == cfg_names_.end()) continue;
+      const auto* spec = findParam(planeNodeParamTable(), it->second);
+      boost::any value;
+      description->getValue(config, value);
+      std::visit(
+          [&](auto* v) {
+            using T = std::remove_pointer_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
+              *v = boost::any_cast<T>(value);
+            else if constexpr (!std::is_same_v<T, std::string>)
+              *v = static_cast<T>(boost::any_cast<int>(value));
+          },
+          spec->field(node));
+    }
+    for (const std::string& error : validate(node)) NODELET_ERROR("reconfigure: %s", error.c_str());
+    node_ = node;
+    params_ = node.pipeline;
+    pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
+    ++reconfigures_;
   }
 
   void connect() {
@@ -110,18 +179,68 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
-    cv::Matx33d K;
-    cv::Mat D;
-    std::string error = fromCameraInfo(*msg, K, D);
+    CameraIntrinsics camera;
+    std::string error = intrinsicsFromCameraInfo(*msg, rectified_, camera);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (error.empty()) error = pipeline_->setCamera(K, D);
+    if (error.empty()) error = pipeline_->setCamera(camera.K, camera.D);
     if (!error.empty()) {
       ++dropped_info_;
       NODELET_WARN_THROTTLE(10.0, "camera_info rejected: %s; image-space planes only",
                             error.c_str());
       return;
     }
+    camera_ = camera;
     info_size_ = cv::Size(static_cast<int>(msg->width), static_cast<int>(msg->height));
+  }
+
+  bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    bool done = false;
+    guard_.run("reset", [&] {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pipeline_->reset();
+      markers_shown_.clear();
+      reset_markers_ = true;
+      last_odom_.reset();
+      last_planes_.reset();
+      tf_conflict_.clear();
+      resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
+      waiting_since_ = -1;
+      ++resets_;
+      NODELET_INFO("reset: the map and the camera pose start over");
+      done = true;
+    });
+    return done;
+  }
+
+  bool onSaveMap(SaveMap::Request& req, SaveMap::Response& res) {
+    guard_.run("save_map", [&] {
+      PlaneArrayConstPtr planes;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        planes = last_planes_;
+      }
+      if (req.path.empty()) {
+        res.message = "no path given";
+      } else if (!planes) {
+        res.message = "no map yet";
+      } else {
+        std::ofstream out(req.path);
+        out << planesYaml(*planes);
+        out.close();
+        if (!out) {
+          res.message = "cannot write " + req.path;
+        } else {
+          res.success = true;
+          for (const auto& p : planes->planes) res.planes += p.metric;
+          res.message = "wrote " + std::to_string(res.planes) + " planes to " + req.path;
+        }
+      }
+      if (res.success)
+        NODELET_INFO("save_map: %s", res.message.c_str());
+      else
+        NODELET_ERROR("save_map: %s", res.message.c_str());
+    });
+    return true;  // the reason is in the response
   }
 
   std::optional<Pose> odometry(const std_msgs::Header& header) {
@@ -150,10 +269,90 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
   }
 
+  // Why publishing parent -> child would break the tf tree (REP 105), "" when it would
+  // not. tf2 keeps the latest parent of each frame: another broadcaster of `child` shows
+  // as another parent, or, before our first transform, as the same edge already there.
+  std::string tfConflict(const std::string& parent, const std::string& child) const {
+    std::string existing;
+    if (tf_buffer_->_getParent(child, ros::Time(0), existing)) {
+      if (existing != parent)
+        return "frame '" + child + "' already has the parent '" + existing +
+               "' on tf: publishing " + parent + " -> " + child + " would give it a second parent";
+      if (!published_edges_.count(parent + " -> " + child))
+        return "'" + parent + " -> " + child + "' is already on tf from another broadcaster";
+    }
+    std::string up = parent;  // no loop: the child must not be above the parent
+    for (int depth = 0; depth < 64 && tf_buffer_->_getParent(up, ros::Time(0), existing); ++depth) {
+      if (existing == child)
+        return "'" + child + "' is above '" + parent + "' on tf: " + parent + " -> " + child +
+               " would make a loop";
+      up = existing;
+    }
+    return {};
+  }
+
+  // The one transform this nodelet publishes for this image, if any (mutex_ held).
+  std::optional<geometry_msgs::TransformStamped> transformFor(const Pose& ros_map_from_camera,
+                                                              const std::optional<Pose>& odom,
+                                                              const std_msgs::Header& header) {
+    if (!publish_tf_ || !tf_conflict_.empty()) return {};
+    std::string parent, child;
+    Pose parent_from_child;
+    if (!odom_frame_.empty()) {
+      // Only the map <-> odom link: the robot's own tree (odom -> base_link -> camera)
+      // is never touched. No odometry for this image: nothing new to say.
+      if (!odom) return {};
+      if (resolved_tf_mode_.empty()) {
+        std::string odom_parent;
+        const bool has_parent = tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
+        resolved_tf_mode_ = tf_mode_ != "auto"                             ? tf_mode_
+                            : has_parent && odom_parent != map_frame_ ? "below_odom"
+                                                                           : "above_odom";
+        if (tf_mode_ == "auto") {
+          const std::string why =
+              resolved_tf_mode_ == "below_odom"
+                  ? "'" + odom_frame_ + "' already has the parent '" + odom_parent +
+                        "': publishing " + odom_frame_ + " -> " + map_frame_
+                  : "publishing " + map_frame_ + " -> " + odom_frame_;
+          NODELET_INFO("tf_mode auto: %s", why.c_str());
+        }
+      }
+      const Pose map_from_odom = ros_map_from_camera * odom->inverse();
+      if (resolved_tf_mode_ == "above_odom") {
+        parent = map_frame_;
+        child = odom_frame_;
+        parent_from_child = map_from_odom;
+      } else {
+        parent = odom_frame_;
+        child = map_frame_;
+        parent_from_child = map_from_odom.inverse();
+      }
+    } else {
+      if (header.frame_id.empty()) {
+        NODELET_WARN_THROTTLE(10.0, "tracks have an empty frame_id: no camera estimate on tf");
+        return {};
+      }
+      // Never the camera's own frame: the robot's URDF is its parent already.
+      parent = map_frame_;
+      child = camera_frame_.empty() ? header.frame_id + "_estimate" : camera_frame_;
+      parent_from_child = ros_map_from_camera;
+    }
+    tf_conflict_ = tfConflict(parent, child);
+    if (!tf_conflict_.empty()) {
+      NODELET_ERROR("tf refused, nothing more is published on tf (until ~reset): %s",
+                    tf_conflict_.c_str());
+      return {};
+    }
+    tf_edge_ = parent + " -> " + child;
+    published_edges_.insert(tf_edge_);
+    return toTransform(parent_from_child, header.stamp, parent, child);
+  }
+
   void onTracks(const TracksConstPtr& msg) {
     const ros::WallTime started = ros::WallTime::now();
+    diagnostics_.tick();
     std::string error;
-    const TrackFrame frame = toTrackFrame(*msg, error);
+    TrackFrame frame = toTrackFrame(*msg, error);
     if (!error.empty()) {
       std::lock_guard<std::mutex> lock(mutex_);
       ++dropped_;
@@ -161,7 +360,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       return;
     }
     const std::optional<Pose> odom = odometry(msg->header);
-    PlaneArrayPtr planes;
+    PlaneArrayPtr planes, image_planes;
+    geometry_msgs::PoseStampedPtr pose;
     visualization_msgs::MarkerArrayPtr markers;
     sensor_msgs::PointCloud2Ptr cloud;
     cv::Mat drawing;
@@ -186,6 +386,12 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",
                               info_size_.width, info_size_.height, frame.size.width,
                               frame.size.height);
+      if (!pipeline_->hasCamera())
+        NODELET_WARN_THROTTLE(10.0,
+                              "tracks arrive but no usable camera_info on %s: image-space "
+                              "planes only",
+                              info_sub_.getTopic().c_str());
+      undistortFisheye(frame, camera_);  // equidistant: pinhole pixels of the same K
       const PipelineResult result = pipeline_->process(frame, odom);
       if (result.was_reset) {
         NODELET_WARN(
@@ -194,6 +400,7 @@ class PlaneNodelet : public nodelet::Nodelet {
             frame.stamp);
         markers_shown_.clear();
         reset_markers_ = true;
+        waiting_since_ = -1;
       }
       if (result.tracking_loss)
         NODELET_WARN_THROTTLE(5.0,
@@ -204,18 +411,31 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
       }
+      if (result.state == PipelineState::kWaitingForTarget) {
+        if (waiting_since_ < 0) waiting_since_ = frame.stamp;
+        waited_s_ = frame.stamp - waiting_since_;
+      } else {
+        waiting_since_ = -1;
+        waited_s_ = 0;
+      }
       ++frames_;
       status_ = result.status;
+      state_ = result.state;
       observed_ = result.planes.size();
-      planes = toPlaneArray(msg->header, map_frame_, result, pipeline_->map());
-      if (planes->metric) planes->camera_pose = toPoseMsg(result.pose->map_from_camera);
+      std_msgs::Header map_header = msg->header;
+      map_header.frame_id = map_frame_;
+      image_planes = toImagePlanes(msg->header, result);
+      planes = toMapPlanes(map_header, result, pipeline_->map());
       if (planes->metric) {
-        std_msgs::Header map_header = msg->header;
-        map_header.frame_id = map_frame_;
+        const Pose ros_map_from_camera = rosMapFromTarget() * result.pose->map_from_camera;
+        pose.reset(new geometry_msgs::PoseStamped);
+        pose->header = map_header;
+        pose->pose = planes->camera_pose;
         if (markers_pub_.getNumSubscribers() > 0 || reset_markers_) {
           markers = toMarkers(map_header, pipeline_->map(), markers_shown_);
           if (reset_markers_) {
             visualization_msgs::Marker clear;
+            clear.header = map_header;
             clear.action = visualization_msgs::Marker::DELETEALL;
             markers->markers.insert(markers->markers.begin(), clear);
             reset_markers_ = false;
@@ -223,15 +443,9 @@ class PlaneNodelet : public nodelet::Nodelet {
         }
         if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
           cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
-        if (publish_tf_ && odom)  // map -> odom, so that the robot's tf tree stays a tree
-          tf = toTransform(result.pose->map_from_camera * odom->inverse(), msg->header, map_frame_,
-                           odom_frame_);
-        else if (publish_tf_ && !msg->header.frame_id.empty())
-          tf = toTransform(result.pose->map_from_camera, msg->header, map_frame_,
-                           msg->header.frame_id);
-        else if (publish_tf_)
-          NODELET_WARN_THROTTLE(10.0, "tracks have an empty frame_id: no map -> camera tf");
+        tf = transformFor(ros_map_from_camera, odom, msg->header);
       }
+      last_planes_ = planes;
       if (debug_pub_.getNumSubscribers() > 0) {
         for (const auto& image : images_)
           if (image->header.stamp == msg->header.stamp) {
@@ -243,9 +457,11 @@ class PlaneNodelet : public nodelet::Nodelet {
           }
       }
     }
-    diagnostics_.tick();
-    planes->processing_ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
+    const float ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
+    planes->processing_ms = image_planes->processing_ms = ms;
     planes_pub_.publish(planes);  // shared pointers: no copy inside one manager
+    image_planes_pub_.publish(image_planes);
+    if (pose) pose_pub_.publish(pose);
     if (markers) markers_pub_.publish(markers);
     if (cloud) cloud_pub_.publish(cloud);
     if (tf) broadcaster_->sendTransform(*tf);
@@ -255,15 +471,30 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     std::lock_guard<std::mutex> lock(mutex_);
+    using diagnostic_msgs::DiagnosticStatus;
     const long exceptions = guard_.count();
-    const bool warn = dropped_ > 0 || dropped_info_ > 0 || refused_odom_ > 0 ||
-                      camera_switches_ > 0 || exceptions > 0;
-    status.summary(
-        warn ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK,
-        exceptions > 0          ? "exceptions caught"
-        : camera_switches_ > 0 ? "tracks mix cameras"
-        : status_.empty()      ? "no tracks yet"
-                               : status_);
+    const bool no_camera = frames_ > 0 && !pipeline_->hasCamera();
+    const bool target_late =
+        state_ == PipelineState::kWaitingForTarget && waited_s_ > target_timeout_s_;
+    const bool lost = state_ == PipelineState::kLost;
+    if (!tf_conflict_.empty())
+      status.summary(DiagnosticStatus::ERROR, "tf conflict: " + tf_conflict_);
+    else if (no_camera)  // the present state first, then what happened since the start
+      status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
+    else if (lost)
+      status.summary(DiagnosticStatus::WARN, "tracking lost: " + status_);
+    else if (target_late)
+      status.summary(DiagnosticStatus::WARN,
+                     "start-up target not seen for " + std::to_string(static_cast<int>(waited_s_)) +
+                         " s");
+    else if (exceptions > 0)
+      status.summary(DiagnosticStatus::WARN, "exceptions caught");
+    else if (camera_switches_ > 0)
+      status.summary(DiagnosticStatus::WARN, "tracks mix cameras");
+    else if (dropped_ > 0 || dropped_info_ > 0 || refused_odom_ > 0)
+      status.summary(DiagnosticStatus::WARN, status_.empty() ? "input refused" : status_);
+    else
+      status.summary(DiagnosticStatus::OK, status_.empty() ? "no tracks yet" : status_);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
     status.add("camera switches (total)", camera_switches_);
@@ -271,6 +502,16 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
+    status.add("camera model", !pipeline_->hasCamera()      ? "none"
+                               : camera_.rectified          ? "rectified (P)"
+                               : !camera_.fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
+                                                            : "raw (K, D)");
+    status.add("tf", !tf_conflict_.empty() ? "refused: " + tf_conflict_
+                     : !publish_tf_        ? std::string("off")
+                     : tf_edge_.empty()    ? std::string("nothing published yet")
+                                           : tf_edge_);
+    status.add("resets (total)", resets_);
+    status.add("reconfigurations (total)", reconfigures_);
     status.add("planes in this image", observed_);
     status.add("planes in the map", pipeline_->map().planes().size());
     if (pipeline_->poseEstimator())
@@ -278,35 +519,47 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   CallbackGuard guard_;  // first member: the last destroyed
+  PlaneNodeParams node_;  // as read, then as reconfigured
   PipelineParams params_;
   std::unique_ptr<PlanePipeline> pipeline_;
-  std::string map_frame_, odom_frame_, transport_;
-  bool publish_tf_ = true;
+  std::string map_frame_, odom_frame_, camera_frame_, transport_, tf_mode_;
+  bool publish_tf_ = true, rectified_ = false;
+  double target_timeout_s_ = 30;
 
-  ros::Publisher planes_pub_, markers_pub_, cloud_pub_;
+  ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_;
+  ros::ServiceServer reset_srv_, save_srv_;
+  std::unique_ptr<dynamic_reconfigure::Server<PlanesConfig>> reconfigure_;
+  std::map<std::string, std::string> cfg_names_;  // .cfg name -> table name
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
   image_transport::Publisher debug_pub_;
   image_transport::Subscriber image_sub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  ros::Timer no_info_timer_;
   NodeletDiagnostics diagnostics_;
 
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;
+  CameraIntrinsics camera_;
   cv::Size info_size_;
   std::set<int> markers_shown_;
   bool reset_markers_ = false;
-  PipelineState last_state_ = PipelineState::kNoCamera;
+  PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
-  long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0;
+  long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
+       resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
+  double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
   std::optional<Pose> last_odom_;
   std::string last_frame_id_;
   cv::Size last_tracks_size_;
   size_t observed_ = 0;
+  PlaneArrayConstPtr last_planes_;
+  std::string resolved_tf_mode_;  // above_odom | below_odom once decided
+  std::string tf_conflict_;       // why tf was refused; "" when fine
+  std::string tf_edge_;           // what is published
+  std::set<std::string> published_edges_;  // links this nodelet has put on tf
 };
 
 }  // namespace mono_plane_detection

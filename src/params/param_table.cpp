@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <stdexcept>
 
 namespace mono_plane_detection {
 
@@ -310,11 +311,25 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
   static const ParamTable<P> table = [] {
     ParamTable<P> t;
     appendNested(t, "", &P::pipeline, pipelineParamTable());
-    t.push_back({"map_frame", field(&P::map_frame), 0, 0, "", "the start-up target's frame"});
+    t.push_back({"map_frame", field(&P::map_frame), 0, 0, "",
+                 "the map's frame: z up (REP 103), origin at the start-up target"});
     t.push_back({"odom_frame", field(&P::odom_frame), 0, 0, "",
                  "set (e.g. odom) to take the camera pose from tf odom -> camera"});
     t.push_back({"publish_tf", field(&P::publish_tf), 0, 1, "",
-                 "map -> camera (or map -> odom with odom_frame)"});
+                 "tf: map_frame -> odom_frame, odom_frame -> map_frame, or map_frame -> "
+                 "camera_frame (tf_mode)"});
+    t.push_back({"tf_mode", field(&P::tf_mode), 0, 0, "",
+                 "with odom_frame: above_odom (map_frame -> odom_frame), below_odom "
+                 "(odom_frame -> map_frame: another localiser owns the odom frame's parent) "
+                 "or auto (below_odom when odom_frame already has a parent)"});
+    t.push_back({"camera_frame", field(&P::camera_frame), 0, 0, "",
+                 "without odom_frame: the camera estimate's own frame, a child of map_frame "
+                 "(\"\": the tracks' frame_id + _estimate)"});
+    t.push_back({"rectified", field(&P::rectified), 0, 1, "",
+                 "the tracks are of rectified images: camera_info's P, no distortion (also "
+                 "when the image topic is image_rect*)"});
+    t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0, 1e6, "s",
+                 "diagnostics: waiting longer than this for the start-up target is a warning"});
     t.push_back({"image_transport", field(&P::image_transport), 0, 0, "",
                  "image_transport hint for the debug image's background"});
     t.push_back({"max_odom_jump_m", field(&P::max_odom_jump_m), 1e-3, 1e6, "m",
@@ -327,6 +342,77 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
     return t;
   }();
   return table;
+}
+
+const std::vector<std::string>& planeRuntimeParamNames() {
+  // Only what PlanePipeline reads on every image (setPerImageParams): the map, pose and
+  // target parameters are held by objects made once.
+  static const std::vector<std::string> names{
+      "frame_gap",
+      "max_gap_s",
+      "planes/vote_threshold_px",
+      "planes/min_plane_support",
+      "planes/max_planes",
+      "planes/refit_iterations",
+      "planes/robust_refit",
+      "planes/merge_fraction",
+      "planes/groups/max_groups",
+      "planes/groups/max_tries",
+      "planes/groups/min_neighbour_distance_px",
+      "planes/groups/min_shape",
+      "planes/groups/invariant_threshold",
+  };
+  return names;
+}
+
+std::string runtimeCfgName(const std::string& table_name) {
+  std::string name = table_name;
+  for (char& c : name)
+    if (c == '/') c = '_';
+  return name;
+}
+
+std::string dynamicReconfigureCfg() {
+  std::ostringstream out;
+  out << "#!/usr/bin/env python3\n"
+         "# PlaneNodelet's parameters that can change while it runs (read on every image).\n"
+         "# Generated from the parameter table (src/params/param_table.cpp) by\n"
+         "# `rosrun mono_plane_detection param_table --cfg > cfg/Planes.cfg`; do not edit by\n"
+         "# hand (test_planes_cfg fails when this file is out of date). Each name is the\n"
+         "# table's with '/' -> '_' (planes/vote_threshold_px: planes_vote_threshold_px).\n"
+         "PACKAGE = \"mono_plane_detection\"\n\n"
+         "from dynamic_reconfigure.parameter_generator_catkin import ParameterGenerator, "
+         "bool_t, double_t, int_t\n\n"
+         "gen = ParameterGenerator()\n";
+  PlaneNodeParams defaults;
+  for (const std::string& name : planeRuntimeParamNames()) {
+    const ParamSpec<PlaneNodeParams>* spec = findParam(planeNodeParamTable(), name);
+    if (!spec) throw std::logic_error("runtime parameter " + name + " is not in the table");
+    const ParamField value = spec->field(defaults);
+    std::string description = spec->description + (spec->unit.empty() ? "" : " (" + spec->unit + ")");
+    for (char& c : description)
+      if (c == '"') c = '\'';
+    out << "gen.add(\"" << runtimeCfgName(name) << "\", ";
+    std::visit(
+        [&](auto* v) {
+          using T = std::remove_pointer_t<decltype(v)>;
+          if constexpr (std::is_same_v<T, bool>) {
+            out << "bool_t, 0, \"" << description << "\", " << (*v ? "True" : "False");
+          } else if constexpr (std::is_same_v<T, double>) {
+            out << "double_t, 0, \"" << description << "\", " << *v << ", " << spec->min << ", "
+                << spec->max;
+          } else if constexpr (std::is_same_v<T, std::string>) {
+            throw std::logic_error("string parameter " + name + " is not for dynamic_reconfigure");
+          } else {
+            out << "int_t, 0, \"" << description << "\", " << *v << ", "
+                << static_cast<long long>(spec->min) << ", " << static_cast<long long>(spec->max);
+          }
+        },
+        value);
+    out << ")\n";
+  }
+  out << "\nexit(gen.generate(PACKAGE, \"plane_nodelet\", \"Planes\"))\n";
+  return out.str();
 }
 
 std::string parametersMarkdown() {

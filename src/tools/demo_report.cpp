@@ -18,6 +18,7 @@
 #include "../sim/bag/ground_truth.h"
 #include "cli_args.h"
 #include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 
 using namespace mono_plane_detection;
@@ -140,8 +141,9 @@ class Report {
       yaml["missed_planes"] = static_cast<int>(eval.missed.size());
       yaml["split_planes"] = static_cast<int>(eval.split.size());
     }
+    // In the target's frame (y up), as the ground truth; the planes topic has them z up.
     std::ofstream(out_ + "/planes.yaml") << "# mono_plane_detection demo: the map's confirmed "
-                                            "planes (map frame, metres)\n"
+                                            "planes (start-up target's frame, y up, metres)\n"
                                          << yaml << "\n";
     writeOverlay();
     writeTopDown(planes);
@@ -174,7 +176,7 @@ class Report {
       overlay_ = {images_[msg->header.stamp], tracks_[msg->header.stamp], msg};
     if (truth_ && msg->metric)
       if (const auto truth = poseAt(*truth_, msg->header.stamp.toSec()))
-        position_errors_.push_back(cv::norm(fromPoseMsg(msg->camera_pose).t - truth->t));
+        position_errors_.push_back(cv::norm(targetFromRosMap(fromPoseMsg(msg->camera_pose)).t - truth->t));
     if (expected_ > 0 && (planes_seen_ % 30 == 0 || planes_seen_ == expected_)) {
       std::printf("  frames %d / %d: %s, %zu planes\n", planes_seen_, expected_,
                   msg->status.c_str(), msg->planes.size());
@@ -263,7 +265,7 @@ class Report {
  public:
   void recordPath() {
     if (last_planes_ && last_planes_->metric && last_planes_.get() != last_recorded_) {
-      path_.push_back(fromPoseMsg(last_planes_->camera_pose).t);
+      path_.push_back(targetFromRosMap(fromPoseMsg(last_planes_->camera_pose)).t);
       last_recorded_ = last_planes_.get();
     }
   }

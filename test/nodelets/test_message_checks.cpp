@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <opencv2/calib3d.hpp>
 
 #include "../../src/nodelets/camera_info_check.h"
 #include "../../src/nodelets/plane_messages.h"
@@ -81,6 +82,70 @@ TEST(CameraInfoCheck, DistortionLengthsOpenCvDoesNotTakeAreRefused) {
   bad = cameraInfo({});
   bad.width = 0;
   EXPECT_NE(cameraInfoError(bad), "");
+}
+
+// image_geometry's semantics: a rectified stream's pixels are P's, without distortion;
+// a raw stream's are K and D (issue 14: image_rect with D gave 0 planes).
+TEST(CameraInfoCheck, RectifiedStreamsUsePWithoutDistortion) {
+  sensor_msgs::CameraInfo info = cameraInfo({-0.3, 0.1, 0, 0, 0});
+  info.P = {450, 0, 300, 0, 0, 460, 230, 0, 0, 0, 1, 0};
+  CameraIntrinsics raw, rect;
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, raw), "");
+  EXPECT_EQ(raw.K(0, 0), 500);
+  EXPECT_EQ(raw.D.total(), 5u);
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, true, rect), "");
+  EXPECT_EQ(rect.K(0, 0), 450);
+  EXPECT_EQ(rect.K(1, 1), 460);
+  EXPECT_EQ(rect.K(0, 2), 300);
+  EXPECT_EQ(rect.K(1, 2), 230);
+  EXPECT_TRUE(rect.D.empty());
+  EXPECT_TRUE(rect.fisheye_D.empty());
+  info.P.fill(0.0);  // a rectified stream without P is refused
+  EXPECT_NE(intrinsicsFromCameraInfo(info, true, rect), "");
+  EXPECT_TRUE(isRectifiedTopic("/camera/image_rect"));
+  EXPECT_TRUE(isRectifiedTopic("/rear/image_rect_color"));
+  EXPECT_FALSE(isRectifiedTopic("/camera/image_raw"));
+  EXPECT_FALSE(isRectifiedTopic("/image_rect_cam/image_raw"));
+}
+
+// Equidistant: the tracks are moved to the pinhole image of the same K with cv::fisheye;
+// points beyond it are dropped; other models are refused with one clear error.
+TEST(CameraInfoCheck, EquidistantThroughCvFisheye) {
+  const std::vector<double> k = {0.05, -0.01, 0.002, -0.0005};
+  CameraIntrinsics camera;
+  ASSERT_EQ(intrinsicsFromCameraInfo(cameraInfo(k, "equidistant"), false, camera), "");
+  ASSERT_EQ(camera.fisheye_D.total(), 4u);
+  EXPECT_TRUE(camera.D.empty());
+  EXPECT_NE(intrinsicsFromCameraInfo(cameraInfo({0.1, 0.1, 0.1}, "equidistant"), false, camera)
+                .find("4 coefficients"),
+            std::string::npos);
+  const std::string other =
+      intrinsicsFromCameraInfo(cameraInfo({0, 0, 0, 0, 0}, "kannala"), false, camera);
+  EXPECT_NE(other.find("'kannala' is not supported"), std::string::npos) << other;
+  ASSERT_EQ(intrinsicsFromCameraInfo(cameraInfo(k, "equidistant"), false, camera), "");
+  // Points in front of the camera, seen by the fisheye and by the pinhole of the same K.
+  std::vector<cv::Point3d> points;
+  for (double x = -0.5; x <= 0.5; x += 0.25)
+    for (double y = -0.35; y <= 0.35; y += 0.175) points.emplace_back(x, y, 1.0);
+  points.emplace_back(0.7, 0.0, 1.0);  // in the fisheye image, beyond the pinhole one
+  std::vector<cv::Point2d> fisheye, pinhole;
+  const cv::Mat D(k, true);
+  cv::fisheye::projectPoints(points, fisheye, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.K,
+                             D.reshape(1, 1));
+  cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), camera.K, cv::Mat(), pinhole);
+  TrackFrame frame;
+  frame.size = {640, 480};
+  for (size_t i = 0; i < points.size(); ++i) {
+    frame.ids.push_back(i + 1);
+    frame.pixels.push_back(fisheye[i]);
+    frame.target_corner.push_back(i == 0);
+  }
+  ASSERT_EQ(validateTrackFrame(frame), "");
+  undistortFisheye(frame, camera);
+  ASSERT_EQ(frame.ids.size(), points.size() - 1);  // the far point is gone
+  for (size_t i = 0; i < frame.ids.size(); ++i)
+    EXPECT_LT(cv::norm(frame.pixels[i] - pinhole[frame.ids[i] - 1]), 0.01) << i;
+  EXPECT_TRUE(frame.target_corner[0]);
 }
 
 // Issue 15, case 1: secs = 4000000000 after 100: ros::Duration threw out of the callback.

@@ -14,6 +14,7 @@
 #include "../../src/sim/bag/ground_truth.h"
 #include "../../src/sim/bag/sequence_writer.h"
 #include "mono_plane_detection/PlaneArray.h"
+#include "mono_plane_detection/ros/map_frame.h"
 #include "support/test_timeouts.h"
 #include "support/temp_path.h"
 
@@ -69,7 +70,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     last = planes[key];
     if (last->metric)
       if (const auto t = poseAt(truth, image->header.stamp.toSec()))
-        position_errors.push_back(cv::norm(fromPoseMsg(last->camera_pose).t - t->t));
+        position_errors.push_back(cv::norm(targetFromRosMap(fromPoseMsg(last->camera_pose)).t - t->t));
   }
   ASSERT_EQ(images, spec.frames);
   ASSERT_TRUE(last);

@@ -14,13 +14,21 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <std_srvs/Empty.h>
+
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <map>
 
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/SaveMap.h"
 #include "mono_plane_detection/geometry/plane_fit.h"
+#include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "support/diagnostics_probe.h"
 #include "support/synthetic_tracks.h"
@@ -70,6 +78,8 @@ class PlaneNodeletTest : public ::testing::Test {
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 2, true);
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 20);
     planes_sub_ = nh_.subscribe("planes", 50, &PlaneNodeletTest::onPlanes, this);
+    image_planes_sub_ =
+        nh_.subscribe("image_planes", 50, &PlaneNodeletTest::onImagePlanes, this);
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
     // Both nodelets live in one manager process: one connection.
     spinUntil(
@@ -82,6 +92,9 @@ class PlaneNodeletTest : public ::testing::Test {
   }
 
   void onPlanes(const PlaneArrayConstPtr& msg) { planes_[msg->header.stamp.toNSec()] = msg; }
+  void onImagePlanes(const PlaneArrayConstPtr& msg) {
+    image_planes_[msg->header.stamp.toNSec()] = msg;
+  }
   void onNoInfo(const PlaneArrayConstPtr& msg) { no_info_[msg->header.stamp.toNSec()] = msg; }
 
   template <typename T>
@@ -111,18 +124,25 @@ class PlaneNodeletTest : public ::testing::Test {
   static SyntheticTracks* world_;
   ros::NodeHandle nh_;
   ros::Publisher tracks_pub_, info_pub_, image_pub_;
-  ros::Subscriber planes_sub_, no_info_sub_;
-  std::map<uint64_t, PlaneArrayConstPtr> planes_, no_info_;
+  ros::Subscriber planes_sub_, image_planes_sub_, no_info_sub_;
+  std::map<uint64_t, PlaneArrayConstPtr> planes_, image_planes_, no_info_;
   visualization_msgs::MarkerArrayConstPtr markers_;
   sensor_msgs::PointCloud2ConstPtr cloud_;
 };
 
 SyntheticTracks* PlaneNodeletTest::world_ = nullptr;
 
-// Runs first: the nodelet has no camera_info yet.
+// Runs first: the nodelet has no camera_info yet. One frame per topic: the map's planes
+// (none yet) in the map frame, this image's planes in the camera's.
 TEST_F(PlaneNodeletTest, A_ImageSpacePlanesUntilCameraInfo) {
-  const PlaneArrayConstPtr last = drive(0, 10, 0);
+  const PlaneArrayConstPtr map = drive(0, 10, 0);
+  ASSERT_TRUE(map);
+  EXPECT_FALSE(map->metric);
+  EXPECT_EQ(map->header.frame_id, "plane_map");
+  EXPECT_TRUE(map->planes.empty());
+  const PlaneArrayConstPtr last = waitFor(image_planes_, map->header.stamp.toNSec());
   ASSERT_TRUE(last);
+  EXPECT_EQ(last->header.frame_id, "camera_optical");
   EXPECT_FALSE(last->metric);
   EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
   ASSERT_FALSE(last->planes.empty());
@@ -159,34 +179,52 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
       [this](const visualization_msgs::MarkerArrayConstPtr& m) { markers_ = m; });
   ros::Subscriber cloud = nh_.subscribe<sensor_msgs::PointCloud2>(
       "map_points", 10, [this](const sensor_msgs::PointCloud2ConstPtr& c) { cloud_ = c; });
+  geometry_msgs::PoseStampedConstPtr pose;
+  ros::Subscriber pose_sub = nh_.subscribe<geometry_msgs::PoseStamped>(
+      "camera_pose", 10, [&](const geometry_msgs::PoseStampedConstPtr& m) { pose = m; });
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   const PlaneArrayConstPtr last = drive(0, 240, 200);
   ASSERT_TRUE(last);
   EXPECT_TRUE(last->metric);
-  EXPECT_EQ(last->header.frame_id, "map");
+  EXPECT_EQ(last->header.frame_id, "plane_map");
   EXPECT_EQ(last->status.rfind("tracking", 0), 0u) << last->status;
-  // The front wall (the target's, map z = 0) and the floor (0.8 m below the target).
+  // REP 103, z up: the front wall (the target's: x = 0, normal towards the camera, -x)
+  // and the floor (0.8 m below the target: z = -0.8, so d = 0.8 in a x + b y + c z + d = 0).
   bool wall = false, floor = false;
   for (const auto& p : last->planes) {
     if (!p.metric || p.observations < 3) continue;
     const cv::Vec3d n(p.normal.x, p.normal.y, p.normal.z);
-    wall |= normalAngleDeg(n, {0, 0, 1}) < 5 && std::abs(p.distance) < 0.1;
-    floor |= normalAngleDeg(n, {0, 1, 0}) < 5 && std::abs(p.distance + 0.8) < 0.1;
+    const bool is_wall = normalAngleDeg(n, {-1, 0, 0}) < 5 && std::abs(p.d) < 0.1;
+    const bool is_floor = normalAngleDeg(n, {0, 0, 1}) < 5 && std::abs(p.d - 0.8) < 0.1;
+    if (is_wall) {
+      EXPECT_EQ(p.label, PlaneEstimate::LABEL_WALL);
+    }
+    if (is_floor) {
+      EXPECT_EQ(p.label, PlaneEstimate::LABEL_FLOOR);
+    }
+    wall |= is_wall;
+    floor |= is_floor;
     EXPECT_GE(p.polygon.size(), 3u);
     EXPECT_GT(p.confidence, 0.0);
+    for (const auto& v : p.polygon)  // the polygon lies on its plane
+      EXPECT_NEAR(n.dot(cv::Vec3d(v.x, v.y, v.z)) + p.d, 0.0, 0.15);
   }
   EXPECT_TRUE(wall);
   EXPECT_TRUE(floor);
   if (!wall || !floor)
     for (const auto& p : last->planes)
       std::printf("plane %d: n (%.2f %.2f %.2f) d %.2f, %u obs\n", p.id, p.normal.x, p.normal.y,
-                  p.normal.z, p.distance, p.observations);
-  // The camera pose in the message against the truth.
-  const Pose truth = world_->truthMapFromCamera(239 / 30.0);
+                  p.normal.z, p.d, p.observations);
+  // The camera pose in the message and on its own topic against the truth (z up).
+  const Pose truth = rosMapFromTarget() * world_->truthMapFromCamera(239 / 30.0);
   EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
   EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
   EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
+  spinUntil([&] { return pose && pose->header.stamp == last->header.stamp; }, 5.0);
+  ASSERT_TRUE(pose);
+  EXPECT_EQ(pose->header.frame_id, "plane_map");
+  EXPECT_NEAR(pose->pose.position.z, truth.t[2], 0.1);
   // Markers, map points and tf were published.
   const ros::WallTime deadline = ros::WallTime::now() + scaledWait(3.0);
   while ((!markers_ || !cloud_) && ros::WallTime::now() < deadline) {
@@ -200,8 +238,12 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   for (const auto& m : markers_->markers)
     polygons += m.ns == "planes" && m.action == visualization_msgs::Marker::ADD;
   EXPECT_GE(polygons, 2);
-  EXPECT_TRUE(buffer.canTransform("map", "camera_optical", ros::Time(0),
+  // Without odometry the estimate is a frame of its own, never the camera's (a URDF
+  // gives that one its parent).
+  EXPECT_TRUE(buffer.canTransform("plane_map", "camera_optical_estimate", ros::Time(0),
                                   ros::Duration(2.0 * timeoutScale())));
+  std::string parent;
+  EXPECT_FALSE(buffer._getParent("camera_optical", ros::Time(0), parent)) << parent;
 }
 
 TEST_F(PlaneNodeletTest, D_BadTracksAreDroppedAndTheMapSurvives) {
@@ -261,7 +303,9 @@ TEST_F(PlaneNodeletTest, E_FewOrVeryManyPointsAreAnswered) {
     const PlaneArrayConstPtr r = send(toTracks(many), 60.0);
     ASSERT_TRUE(r);
     slowest = std::max(slowest, (ros::WallTime::now() - start).toSec());
-    for (const auto& p : r->planes) observed += p.observed;
+    const PlaneArrayConstPtr image = waitFor(image_planes_, r->header.stamp.toNSec());
+    ASSERT_TRUE(image);
+    for (const auto& p : image->planes) observed += p.observed;
   }
   EXPECT_GT(observed, 0u);  // the shift is one homography: it was really searched
   std::printf("10000 points: slowest answer %.0f ms\n", slowest * 1e3);
@@ -344,11 +388,20 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   }
   EXPECT_EQ(last->status, "tracking (odometry)");
   const Pose truth = world_->truthMapFromCamera(89 / 30.0);
-  EXPECT_NEAR(last->camera_pose.position.x, truth.t[0], 0.1);
-  EXPECT_NEAR(last->camera_pose.position.y, truth.t[1], 0.1);
-  EXPECT_NEAR(last->camera_pose.position.z, truth.t[2], 0.1);
-  EXPECT_TRUE(buffer.canTransform("map_odom_test", "odom", ros::Time(0),
+  const Pose in_ros_map = targetFromRosMap(fromPoseMsg(last->camera_pose));
+  EXPECT_NEAR(in_ros_map.t[0], truth.t[0], 0.1);
+  EXPECT_NEAR(in_ros_map.t[1], truth.t[1], 0.1);
+  EXPECT_NEAR(in_ros_map.t[2], truth.t[2], 0.1);
+  ASSERT_TRUE(buffer.canTransform("map_odom_test", "camera_optical", ros::Time(0),
                                   ros::Duration(2.0 * timeoutScale())));
+  // map -> odom (ours) then odom -> camera (the robot's): the camera where it truly is.
+  const Pose through_tf = fromTransformMsg(
+      buffer.lookupTransform("map_odom_test", "camera_optical", ros::Time(0)).transform);
+  const Pose ros_truth = rosMapFromTarget() * truth;
+  EXPECT_LT(cv::norm(through_tf.t - ros_truth.t), 0.1);
+  std::string parent;
+  ASSERT_TRUE(buffer._getParent("odom", ros::Time(0), parent));
+  EXPECT_EQ(parent, "map_odom_test");
 }
 
 // Killing the plane nodelet while tracks keep coming, and loading it again: it answers
@@ -487,6 +540,119 @@ TEST_F(PlaneNodeletTest, M_TwoCamerasOnOneTracksTopicAreReported) {
   EXPECT_GE(diagnostics.number("camera switches (total)") - before, 9);
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
+}
+
+// ~save_map writes the map's planes as YAML; ~reset empties the map and the pose: the
+// next answer has no plane and is not metric, and the map comes back with the target.
+TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
+  info_pub_.publish(cameraInfo(world_->camera));
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));  // after M's camera mix
+  const PlaneArrayConstPtr before = drive(0, 120, 3000);
+  ASSERT_TRUE(before);
+  ASSERT_TRUE(before->metric) << before->status;
+  size_t confirmed = 0;
+  for (const auto& p : before->planes) confirmed += p.metric;
+  ASSERT_GE(confirmed, 2u);
+
+  SaveMap save;
+  save.request.path = ::testing::TempDir() + "plane_nodelet_map.yaml";
+  ASSERT_TRUE(ros::service::call("/plane_detector/save_map", save));
+  EXPECT_TRUE(save.response.success) << save.response.message;
+  EXPECT_EQ(save.response.planes, confirmed);
+  std::ifstream in(save.request.path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("frame_id: plane_map"), std::string::npos);
+  EXPECT_NE(text.str().find("label: floor"), std::string::npos);
+  EXPECT_NE(text.str().find("label: wall"), std::string::npos);
+  SaveMap nowhere;
+  nowhere.request.path = "/nonexistent_dir/map.yaml";
+  ASSERT_TRUE(ros::service::call("/plane_detector/save_map", nowhere));
+  EXPECT_FALSE(nowhere.response.success);
+
+  ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));
+  // The stream goes on (stamps keep increasing): only the reset empties the map.
+  const PlaneArrayConstPtr after = drive(120 / 30.0, 1, 3000);
+  ASSERT_TRUE(after);
+  EXPECT_FALSE(after->metric) << after->status;
+  EXPECT_TRUE(after->planes.empty());
+  const PlaneArrayConstPtr again = drive(0, 90, 3010);
+  ASSERT_TRUE(again);
+  EXPECT_TRUE(again->metric) << again->status;
+  // Its own earlier tf link is no conflict after the reset.
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  drive(90 / 30.0, 40, 3010);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_EQ(diagnostics.value("tf"), "plane_map -> camera_optical_estimate");
+  EXPECT_GE(diagnostics.number("resets (total)"), 2);
+}
+
+// dynamic_reconfigure: planes_max_planes = 1 caps this image's planes at one from the next
+// image on (two or more before); back to 8, they come back. Diagnostics count both.
+TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
+  auto planesNow = [&](double t0, double offset) {
+    size_t most = 0;
+    for (int k = 0; k < 10; ++k) {
+      const PlaneArrayConstPtr map = drive(t0 + k / 30.0, 1, offset);
+      if (!map) return static_cast<size_t>(1000);
+      const PlaneArrayConstPtr image = waitFor(image_planes_, map->header.stamp.toNSec());
+      if (!image) return static_cast<size_t>(1000);
+      most = std::max(most, image->planes.size());
+    }
+    return most;
+  };
+  auto setMaxPlanes = [&](int n) {
+    dynamic_reconfigure::Reconfigure srv;
+    dynamic_reconfigure::IntParameter p;
+    p.name = "planes_max_planes";
+    p.value = n;
+    srv.request.config.ints.push_back(p);
+    EXPECT_TRUE(ros::service::call("/plane_detector/set_parameters", srv));
+    bool echoed = false;
+    for (const auto& i : srv.response.config.ints)
+      echoed |= i.name == "planes_max_planes" && i.value == n;
+    EXPECT_TRUE(echoed);
+  };
+  const size_t before = planesNow(4.0, 4000);
+  EXPECT_GE(before, 2u);
+  EXPECT_LT(before, 1000u);
+  setMaxPlanes(1);
+  const size_t capped = planesNow(4.5, 4000);
+  EXPECT_EQ(capped, 1u);
+  setMaxPlanes(8);
+  EXPECT_GE(planesNow(5.0, 4000), 2u);
+  std::printf("image planes: %zu, with planes_max_planes 1: %zu\n", before, capped);
+  // The YAML's nested values were the server's start, not the .cfg defaults.
+  int max_groups = 0;
+  EXPECT_TRUE(ros::param::get("/plane_detector/planes_groups_max_groups", max_groups));
+  EXPECT_EQ(max_groups, 100);  // config/planes.yaml (the .cfg default is 300)
+}
+
+// Diagnostics WARN when the start-up target has not been seen for target_timeout_s (30 s
+// of tracks stamps), and OK again once it is.
+TEST_F(PlaneNodeletTest, P_TargetNotSeenIsAWarning) {
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  for (int k = 0; k <= 4; ++k) {  // the room without the target's flags, 10 s apart
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp = 5000 + 10.0 * k;
+    f.target_corner.assign(f.target_corner.size(), false);
+    ASSERT_TRUE(send(toTracks(f)));
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());  // a status made after the last tracks
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN) << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("start-up target not seen for 40 s"), std::string::npos)
+      << diagnostics.message();
+  const PlaneArrayConstPtr seen = drive(0, 3, 5041);
+  ASSERT_TRUE(seen);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.message().find("start-up target not seen"), std::string::npos)
+      << diagnostics.message();
 }
 
 }  // namespace

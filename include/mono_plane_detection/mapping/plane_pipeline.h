@@ -69,6 +69,9 @@ class PlanePipeline {
   const PlaneMap& map() const { return map_; }
   const PoseEstimator* poseEstimator() const { return pose_ ? &*pose_ : nullptr; }
   const PipelineParams& params() const { return params_; }
+  // The parameters read anew on every image (planes/..., frame_gap, max_gap_s): the next
+  // image uses them (dynamic_reconfigure); the others need a new pipeline.
+  void setPerImageParams(const PlaneParams& planes, int frame_gap, double max_gap_s);
   void reset();
 
  private:

@@ -140,9 +140,13 @@ struct TrackerNodeParams {
 
 struct PlaneNodeParams {
   PipelineParams pipeline;  // frame_gap, planes/..., pose/..., map/..., target/...
-  std::string map_frame = "map";
+  std::string map_frame = "plane_map";
   std::string odom_frame;
   bool publish_tf = true;
+  std::string tf_mode = "auto";      // auto | above_odom | below_odom (docs/ros_interface.md)
+  std::string camera_frame;          // no odometry: child of map_frame; "" = <tracks frame>_estimate
+  bool rectified = false;            // the tracks are of rectified images (P, no distortion)
+  double target_timeout_s = 30.0;
   std::string image_transport = "raw";
   double max_odom_jump_m = 1.0;
   double expected_min_rate_hz = 5.0;
@@ -160,6 +164,15 @@ const ParamTable<MapParams>& mapParamTable();
 const ParamTable<PipelineParams>& pipelineParamTable();
 const ParamTable<TrackerNodeParams>& trackerNodeParamTable();
 const ParamTable<PlaneNodeParams>& planeNodeParamTable();
+
+// The PlaneNodelet parameters that can change while it runs (dynamic_reconfigure): read
+// anew on every image. Table names; in cfg/Planes.cfg each is the name with '/' -> '_'.
+const std::vector<std::string>& planeRuntimeParamNames();
+std::string runtimeCfgName(const std::string& table_name);
+
+// cfg/Planes.cfg (dynamic_reconfigure), generated from the table for those parameters
+// (param_table --cfg; test_planes_cfg checks the committed file is up to date).
+std::string dynamicReconfigureCfg();
 
 // docs/parameters.md: both nodelets' tables (generated; test_param_table checks the
 // committed file is up to date).

@@ -1,5 +1,7 @@
 #include "ground_truth.h"
 
+#include "mono_plane_detection/ros/map_frame.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -61,11 +63,13 @@ std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm) {
   std::vector<MapPlane> out;
   for (const auto& p : msg.planes) {
     if (!p.metric || static_cast<int>(p.observations) < confirm) continue;
+    // Back from the ROS map (z up, shape_msgs sign) to the target's frame of the truth.
+    const cv::Matx33d target_from_ros = rosMapFromTarget().R.t();
     MapPlane m;
     m.id = p.id;
-    m.normal = cv::Vec3d(p.normal.x, p.normal.y, p.normal.z);
-    m.distance = p.distance;
-    for (const auto& v : p.polygon) m.polygon.emplace_back(v.x, v.y, v.z);
+    m.normal = target_from_ros * cv::Vec3d(p.normal.x, p.normal.y, p.normal.z);
+    m.distance = -p.d;
+    for (const auto& v : p.polygon) m.polygon.push_back(target_from_ros * cv::Vec3d(v.x, v.y, v.z));
     m.observations = static_cast<int>(p.observations);
     m.confidence = p.confidence;
     m.rms_m = p.rms_m;

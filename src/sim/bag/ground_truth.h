@@ -29,7 +29,9 @@ GroundTruth loadGroundTruth(const std::string& yaml_path);
 std::optional<Pose> poseAt(const GroundTruth& truth, double stamp);
 
 // The metric planes of a PlaneArray as map planes (id, normal, distance, polygon,
-// observations, confidence); confirmed_only drops those seen fewer than `confirm` times.
+// observations, confidence) in the core's map frame (the target's, where the truth is:
+// the message's ROS map frame and d sign undone, ros/map_frame.h); those seen fewer
+// than `confirm` times are dropped.
 std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm = 3);
 
 }  // namespace mono_plane_detection

@@ -1,0 +1,351 @@
+// The pipeline as a robot sees it (issue 14), on real messages through the launch files:
+//  TwoCameras: cameras in one roscore (plane_detection.launch three times: front and rear
+//    in one manager, side in its own), under simulated time; front raw with distortion (K, D),
+//    rear rectified (image_rect: P, no distortion) -- the same accuracy; diagnostics OK
+//    during the replay and again after a pause.
+//  TfTree: a URDF-like static tree (base_link -> camera_optical) plus odometry (odom ->
+//    base_link): tf stays a tree, the nodelet publishes plane_map -> odom only, and
+//    plane_map -> base_link is where the truth says. With ~localiser, another localiser
+//    publishes map -> odom: the nodelet attaches odom -> plane_map instead. A second
+//    nodelet told to publish the camera's own frame refuses (ERROR in diagnostics).
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <map>
+#include <set>
+#include <string>
+
+#include "mono_plane_detection/PlaneArray.h"
+#include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/ros/map_frame.h"
+#include "mono_plane_detection/ros/pose_msg.h"
+#include "support/diagnostics_probe.h"
+#include "support/synthetic_tracks.h"
+#include "support/test_timeouts.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+TracksPtr toTracks(const TrackFrame& f, const std::string& frame_id) {
+  TracksPtr msg(new Tracks);
+  msg->header.stamp = ros::Time(f.stamp);
+  msg->header.frame_id = frame_id;
+  msg->width = static_cast<uint32_t>(f.size.width);
+  msg->height = static_cast<uint32_t>(f.size.height);
+  for (size_t i = 0; i < f.ids.size(); ++i) {
+    msg->id.push_back(f.ids[i]);
+    msg->u.push_back(static_cast<float>(f.pixels[i].x));
+    msg->v.push_back(static_cast<float>(f.pixels[i].y));
+    msg->prev_index.push_back(-1);
+    msg->flags.push_back(Tracks::FLAG_TRACKED |
+                         (f.target_corner[i] ? Tracks::FLAG_TARGET_CORNER : 0));
+    msg->age.push_back(0);
+  }
+  return msg;
+}
+
+// A raw camera's calibration: K and D of `raw`, and P = `rectified` (what image_proc's
+// image_rect is projected with).
+sensor_msgs::CameraInfo cameraInfo(const CameraModel& raw, const CameraModel& rectified,
+                                   const std::string& frame_id) {
+  sensor_msgs::CameraInfo info;
+  info.header.frame_id = frame_id;
+  info.width = static_cast<uint32_t>(raw.size.width);
+  info.height = static_cast<uint32_t>(raw.size.height);
+  info.distortion_model = "plumb_bob";
+  info.D = {raw.k1, raw.k2, 0, 0, 0};
+  const cv::Matx33d K = raw.K();
+  for (int i = 0; i < 9; ++i) info.K[i] = K.val[i];
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {rectified.fx, 0, rectified.cx, 0, 0, rectified.fy, rectified.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+// Answers of one planes topic by stamp.
+struct Answers {
+  std::map<uint64_t, PlaneArrayConstPtr> by_stamp;
+  ros::Subscriber sub;
+  Answers(ros::NodeHandle& nh, const std::string& topic) {
+    sub = nh.subscribe<PlaneArray>(topic, 50, [this](const PlaneArrayConstPtr& m) {
+      by_stamp[m->header.stamp.toNSec()] = m;
+    });
+  }
+  PlaneArrayConstPtr wait(const ros::Time& stamp, double seconds = 10.0) {
+    const uint64_t key = stamp.toNSec();
+    spinUntil([&] { return by_stamp.count(key) > 0; }, seconds);
+    return by_stamp.count(key) ? by_stamp.at(key) : nullptr;
+  }
+};
+
+double positionError(const PlaneArray& planes, const Pose& truth_target_from_camera) {
+  const Pose truth = rosMapFromTarget() * truth_target_from_camera;
+  return cv::norm(fromPoseMsg(planes.camera_pose).t - truth.t);
+}
+
+TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
+  ros::NodeHandle nh;
+  ASSERT_TRUE(ros::Time::isSimTime());
+  SyntheticTracks front("wheeled"), rear("wheeled");
+  front.camera.k1 = -0.15;  // the raw image: barrel distortion
+  front.camera.k2 = 0.02;
+  rear.camera.fx = rear.camera.fy = 470;  // the rectified image: P's pinhole
+  rear.camera.cx = 322;
+  rear.camera.cy = 236;
+  ros::Publisher clock = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  ros::Publisher front_tracks = nh.advertise<Tracks>("/front/tracks", 20);
+  ros::Publisher rear_tracks = nh.advertise<Tracks>("/rear/tracks", 20);
+  ros::Publisher front_info = nh.advertise<sensor_msgs::CameraInfo>("/front/camera_info", 1, true);
+  ros::Publisher rear_info = nh.advertise<sensor_msgs::CameraInfo>("/rear/camera_info", 1, true);
+  ros::Publisher side_tracks = nh.advertise<Tracks>("/side/tracks", 20);
+  ros::Publisher side_info = nh.advertise<sensor_msgs::CameraInfo>("/side/camera_info", 1, true);
+  Answers front_planes(nh, "/front/planes"), rear_planes(nh, "/rear/planes"),
+      side_planes(nh, "/side/planes");
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  front_info.publish(cameraInfo(front.camera, front.camera, "front_optical"));
+  // The rear camera's raw calibration (distorted, other K) with the rectified P.
+  rear_info.publish(cameraInfo(front.camera, rear.camera, "rear_optical"));
+  side_info.publish(cameraInfo(rear.camera, rear.camera, "side_optical"));
+  spinUntil(
+      [&] {
+        return front_tracks.getNumSubscribers() > 0 && rear_tracks.getNumSubscribers() > 0 &&
+               side_tracks.getNumSubscribers() > 0 && front_planes.sub.getNumPublishers() > 0 &&
+               rear_planes.sub.getNumPublishers() > 0 && side_planes.sub.getNumPublishers() > 0;
+      },
+      30.0);
+  ASSERT_GT(front_tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(rear_tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(side_tracks.getNumSubscribers(), 0u);
+  // Front and rear in the front camera's manager, side in its own; same names, own namespaces.
+  std::vector<std::string> nodes;
+  ros::master::getNodes(nodes);
+  const std::set<std::string> names(nodes.begin(), nodes.end());
+  EXPECT_TRUE(names.count("/front/plane_detection_manager"));
+  EXPECT_FALSE(names.count("/rear/plane_detection_manager"));
+  EXPECT_TRUE(names.count("/front/plane_detector"));
+  EXPECT_TRUE(names.count("/rear/plane_detector"));
+  EXPECT_TRUE(names.count("/side/plane_detection_manager"));
+  EXPECT_TRUE(names.count("/side/plane_detector"));
+  EXPECT_TRUE(names.count("/side/tracker"));
+  EXPECT_TRUE(names.count("/front/tracker"));
+
+  std::vector<double> front_errors, rear_errors;
+  auto play = [&](int from, int to) {
+    for (int k = from; k < to; ++k) {
+      const double t = k / 30.0;
+      const TrackFrame f = front.frame(t), r = rear.frame(t);
+      rosgraph_msgs::Clock now;
+      now.clock = ros::Time(f.stamp);
+      clock.publish(now);
+      front_tracks.publish(toTracks(f, "front_optical"));
+      rear_tracks.publish(toTracks(r, "rear_optical"));
+      side_tracks.publish(toTracks(r, "side_optical"));
+      const PlaneArrayConstPtr a = front_planes.wait(ros::Time(f.stamp));
+      const PlaneArrayConstPtr b = rear_planes.wait(ros::Time(r.stamp));
+      const PlaneArrayConstPtr c = side_planes.wait(ros::Time(r.stamp));
+      if (!a || !b || !c) return false;
+      if (k >= 150 && a->metric) front_errors.push_back(positionError(*a, front.truthMapFromCamera(t)));
+      if (k >= 150 && b->metric) rear_errors.push_back(positionError(*b, rear.truthMapFromCamera(t)));
+      ros::WallDuration(1.0 / 60).sleep();  // about 30 Hz with the answers' time
+    }
+    return true;
+  };
+  ASSERT_TRUE(play(0, 240)) << "an image was not answered";
+  const PlaneArrayConstPtr a = front_planes.by_stamp.rbegin()->second;
+  const PlaneArrayConstPtr b = rear_planes.by_stamp.rbegin()->second;
+  EXPECT_EQ(a->header.frame_id, "front_map");
+  EXPECT_EQ(b->header.frame_id, "rear_map");
+  EXPECT_TRUE(a->metric) << a->status;
+  EXPECT_TRUE(b->metric) << b->status;
+  const PlaneArrayConstPtr c = side_planes.by_stamp.rbegin()->second;
+  EXPECT_EQ(c->header.frame_id, "side_map");
+  EXPECT_TRUE(c->metric) << c->status;
+  double front_worst = 0, rear_worst = 0;
+  for (double e : front_errors) front_worst = std::max(front_worst, e);
+  for (double e : rear_errors) rear_worst = std::max(rear_worst, e);
+  std::printf("raw (K, D): %zu poses, worst %.3f m; rectified (P): %zu poses, worst %.3f m\n",
+              front_errors.size(), front_worst, rear_errors.size(), rear_worst);
+  EXPECT_GE(front_errors.size(), 80u);
+  EXPECT_GE(rear_errors.size(), 80u);
+  EXPECT_LT(front_worst, 0.1);
+  EXPECT_LT(rear_worst, 0.1);
+  EXPECT_LT(rear_worst, front_worst + 0.05);  // the same accuracy
+  EXPECT_TRUE(buffer.canTransform("front_map", "front_optical_estimate", ros::Time(0),
+                                  ros::Duration(2.0)));
+  EXPECT_TRUE(
+      buffer.canTransform("rear_map", "rear_optical_estimate", ros::Time(0), ros::Duration(2.0)));
+
+  // Diagnostics under simulated time: the input rate and the node's own status are OK
+  // during the replay, a pause shows, and after it they are OK again.
+  DiagnosticsProbe rate(nh, "front/plane_detector: input rate");
+  DiagnosticsProbe status(nh, "front/plane_detector: planes");
+  ASSERT_TRUE(play(240, 300));
+  ASSERT_TRUE(rate.waitFresh());
+  ASSERT_TRUE(status.waitFresh());
+  EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
+  EXPECT_EQ(status.level(), diagnostic_msgs::DiagnosticStatus::OK) << status.message();
+  const double hz = std::stod(rate.value("actual frequency (Hz)"));
+  EXPECT_GT(hz, 10.0);
+  EXPECT_LT(hz, 60.0);
+  ros::WallDuration(6.0).sleep();  // the bag is paused: no clock, no tracks
+  ASSERT_TRUE(rate.waitFresh());
+  EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::WARN) << rate.message();
+  ASSERT_TRUE(play(300, 480));
+  ASSERT_TRUE(rate.waitFresh());
+  EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
+}
+
+// Every transform on /tf and /tf_static: the parents of each child, and who sent what.
+struct TfRecorder {
+  std::map<std::string, std::set<std::string>> parents;               // child -> parents
+  std::map<std::string, std::set<std::string>> edges_by_publisher;    // node -> "a -> b"
+  ros::Subscriber tf, tf_static;
+  explicit TfRecorder(ros::NodeHandle& nh) {
+    tf = nh.subscribe("/tf", 100, &TfRecorder::record, this);
+    tf_static = nh.subscribe("/tf_static", 100, &TfRecorder::record, this);
+  }
+  // A MessageEvent member: it carries the publisher's name (connection header).
+  void record(const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
+    for (const auto& t : event.getMessage()->transforms) {
+      parents[t.child_frame_id].insert(t.header.frame_id);
+      edges_by_publisher[event.getPublisherName()].insert(t.header.frame_id + " -> " +
+                                                          t.child_frame_id);
+    }
+  }
+};
+
+TEST(TfTree, StaysATreeWithOdometry) {
+  ros::NodeHandle nh, pnh("~");
+  bool localiser = false;
+  pnh.param("localiser", localiser, false);
+  TfRecorder recorder(nh);
+  SyntheticTracks world("wheeled");
+  ros::Publisher tracks = nh.advertise<Tracks>("/camera/tracks", 20);
+  ros::Publisher info = nh.advertise<sensor_msgs::CameraInfo>("/camera/camera_info", 1, true);
+  ros::Publisher conflict_tracks = nh.advertise<Tracks>("/conflict/tracks", 20);
+  ros::Publisher conflict_info =
+      nh.advertise<sensor_msgs::CameraInfo>("/conflict/camera_info", 1, true);
+  Answers planes(nh, "/camera/planes"), conflict_planes(nh, "/conflict/planes");
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  tf2_ros::TransformBroadcaster broadcaster;
+  tf2_ros::StaticTransformBroadcaster urdf;
+  // The robot's URDF: the camera 0.3 m ahead of and 1.0 m above base_link, looking
+  // forward (optical frame: z forward, x right, y down).
+  const Pose base_from_camera{cv::Matx33d(0, 0, 1, -1, 0, 0, 0, -1, 0), {0.3, 0, 1.0}};
+  geometry_msgs::TransformStamped mount;
+  mount.header.stamp = ros::Time::now();
+  mount.header.frame_id = "base_link";
+  mount.child_frame_id = "camera_optical";
+  mount.transform = toTransformMsg(base_from_camera);
+  urdf.sendTransform(mount);
+  info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
+  conflict_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
+  spinUntil(
+      [&] {
+        return tracks.getNumSubscribers() > 0 && conflict_tracks.getNumSubscribers() > 0 &&
+               planes.sub.getNumPublishers() > 0;
+      },
+      30.0);
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(conflict_tracks.getNumSubscribers(), 0u);
+  scaledWait(1.0).sleep();  // the static tree reaches the nodelets' tf listeners
+
+  // Odometry: the truth seen from an odometry origin 1 m aside and turned 0.3 rad about z
+  // (odom is z up: REP 105); another localiser's map -> odom is a fixed shift.
+  const Pose ros_from_target = rosMapFromTarget();
+  const Pose odom_from_rosmap{cv::Matx33d(std::cos(0.3), -std::sin(0.3), 0, std::sin(0.3),
+                                          std::cos(0.3), 0, 0, 0, 1),
+                              {1, 0.5, 0}};
+  const Pose amcl_map_from_odom{cv::Matx33d::eye(), {-2, 3, 0}};
+  const ros::Time start = ros::Time::now();
+  PlaneArrayConstPtr last;
+  Pose truth_map_from_base;
+  ros::Time last_stamp;
+  for (int k = 0; k < 150; ++k) {
+    const double t = k / 30.0;
+    TrackFrame f = world.frame(t);
+    f.stamp = (start + ros::Duration(t)).toSec();
+    const ros::Time stamp(f.stamp);  // what the tracks carry: the same nanoseconds on tf
+    truth_map_from_base = ros_from_target * world.truthMapFromCamera(t) * base_from_camera.inverse();
+    std::vector<geometry_msgs::TransformStamped> out;
+    geometry_msgs::TransformStamped odom;
+    odom.header.stamp = stamp;
+    odom.header.frame_id = "odom";
+    odom.child_frame_id = "base_link";
+    odom.transform = toTransformMsg(odom_from_rosmap * truth_map_from_base);
+    out.push_back(odom);
+    if (localiser) {
+      geometry_msgs::TransformStamped amcl;
+      amcl.header.stamp = stamp;
+      amcl.header.frame_id = "map";
+      amcl.child_frame_id = "odom";
+      amcl.transform = toTransformMsg(amcl_map_from_odom);
+      out.push_back(amcl);
+    }
+    broadcaster.sendTransform(out);
+    ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    tracks.publish(toTracks(f, "camera_optical"));
+    conflict_tracks.publish(toTracks(f, "camera_optical"));
+    last = planes.wait(stamp);
+    ASSERT_TRUE(last) << "image " << k;
+    ASSERT_TRUE(conflict_planes.wait(stamp)) << "image " << k;
+    last_stamp = stamp;
+  }
+  EXPECT_EQ(last->status, "tracking (odometry)");
+  spinUntil([] { return false; }, 1.0);  // the last transforms arrive
+
+  // A tree: every frame has one parent, the robot's frames keep theirs.
+  for (const auto& [child, set] : recorder.parents) {
+    EXPECT_EQ(set.size(), 1u) << child << " has " << set.size() << " parents";
+  }
+  EXPECT_EQ(*recorder.parents["camera_optical"].begin(), "base_link");
+  EXPECT_EQ(*recorder.parents["base_link"].begin(), "odom");
+  for (const auto& [node, edges] : recorder.edges_by_publisher)
+    for (const auto& edge : edges) std::printf("tf from %s: %s\n", node.c_str(), edge.c_str());
+  // Only the one link from the pipeline's manager; nothing from the refusing one.
+  const std::set<std::string> ours = recorder.edges_by_publisher["/camera/plane_detection_manager"];
+  ASSERT_EQ(ours.size(), 1u);
+  EXPECT_EQ(*ours.begin(), localiser ? "odom -> plane_map" : "plane_map -> odom");
+  EXPECT_EQ(recorder.edges_by_publisher.count("/conflict/manager"), 0u);
+  // plane_map -> base_link through tf, against the truth.
+  ASSERT_TRUE(buffer.canTransform("plane_map", "base_link", last_stamp, ros::Duration(2.0)));
+  const Pose through_tf = fromTransformMsg(
+      buffer.lookupTransform("plane_map", "base_link", last_stamp).transform);
+  const double error = cv::norm(through_tf.t - truth_map_from_base.t);
+  std::printf("plane_map -> base_link via tf: %.3f m from the truth\n", error);
+  EXPECT_LT(error, 0.1);
+  const cv::Matx33d dR = through_tf.R.t() * truth_map_from_base.R;
+  EXPECT_GT((dR.val[0] + dR.val[4] + dR.val[8] - 1) / 2, std::cos(3 * CV_PI / 180));
+  if (localiser) {
+    std::string parent;
+    ASSERT_TRUE(buffer._getParent("odom", ros::Time(0), parent));
+    EXPECT_EQ(parent, "map");  // the localiser's link is untouched
+  }
+
+  // The nodelet told to publish the camera's own frame refused, loudly.
+  DiagnosticsProbe conflict(nh, "conflict/plane_detector: planes");
+  ASSERT_TRUE(conflict.waitFresh());
+  EXPECT_EQ(conflict.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << conflict.message();
+  EXPECT_NE(conflict.message().find("second parent"), std::string::npos) << conflict.message();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_ros_interface");
+  ros::NodeHandle nh;
+  readTimeoutScale();
+  return RUN_ALL_TESTS();
+}
