@@ -131,13 +131,15 @@ class TrackerNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const TrackerCounts& c = front_.counts();
     const long exceptions = guard_.count();
-    const bool warn = c.dropped > 0 || c.camera_switches > 0 || exceptions > 0;
+    const bool no_target = front_.targetOverdue();
+    const bool warn = c.dropped > 0 || c.camera_switches > 0 || exceptions > 0 || no_target;
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
                    : c.camera_switches > 0 ? "image stream mixes cameras"
                    : c.dropped > 0         ? "images dropped"
-                                           : "tracking");
+                   : no_target            ? "no start-up target: " + front_.targetReason()
+                                           : std::string("tracking"));
     status.add("points tracked", c.tracked_now);
     status.add("points lost (total)", c.lost);
     status.add("searches (total)", c.searches);
@@ -150,6 +152,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
+    if (front_.params().detect_target && !front_.targetFound()) {
+      // What to fix at the robot: light, background, distance (docs/start_up.md).
+      status.add("target type", front_.params().target.target_type);
+      status.add("target: last rejection", front_.targetReason());
+      status.add("target: waiting (s)", front_.targetWaitS());
+    }
   }
 
   CallbackGuard guard_;  // first member: the last destroyed
