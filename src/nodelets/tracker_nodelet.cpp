@@ -157,6 +157,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       status.add("target type", front_.params().target.target_type);
       status.add("target: last rejection", front_.targetReason());
       status.add("target: waiting (s)", front_.targetWaitS());
+      status.add("target: overdue", no_target);  // past target_timeout_s
     }
   }
 
