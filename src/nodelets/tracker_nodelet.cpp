@@ -95,6 +95,13 @@ class TrackerNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(state_mutex_);
       out = front_.process(msg);
       for (const LogEvent& event : out.warnings) warn(event);
+      // Before target_timeout_s: why the target is not seen yet, now and then (after it, a
+      // WARN says so every 5 s).
+      if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
+          !front_.targetOverdue())
+        NODELET_INFO_THROTTLE(10.0, "waiting for the start-up target (%s): %s",
+                              front_.params().target.target_type.c_str(),
+                              front_.targetReason().c_str());
       if (!out.tracks) {
         if (out.dropped_is_error)
           NODELET_ERROR_THROTTLE(5.0, "dropping image: %s", out.dropped.c_str());
