@@ -5,11 +5,9 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <cstdio>
-#include <cstdlib>
 #include <optional>
 #include <sstream>
-#include <cstdio>
+#include <utility>
 #include <vector>
 
 #include "mono_plane_detection/tracking/marker_target.h"
@@ -507,6 +505,8 @@ std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double f
   return r->aspect;
 }
 
+namespace {
+
 // The aspect check. With the focal length known (the nodelet: camera_info), the
 // rectified width/height must be the sheet's. Unknown (a photo given to detect_target):
 // some focal length from 0.5 to 5 image sizes (a cropped photo has a long one) must make
@@ -532,6 +532,8 @@ std::pair<double, double> aspectError(const Quad& quad, cv::Size image, double f
   for (double f = 0.5 * size; f <= 5.0 * size; f *= 1.08) consider(f, true);
   return best;
 }
+
+}  // namespace
 
 std::array<cv::Point3d, 4> targetCornersInMap(const TargetParams& p) {
   const bool marker = p.target_type == "aruco";
