@@ -92,6 +92,18 @@ std::string TrackerFrontEnd::targetReason() const {
   return target_startup_.lastDetection().reason;
 }
 
+std::string TrackerFrontEnd::targetRejections() const {
+  if (target_startup_.found()) return {};
+  std::ostringstream out;
+  const auto& counts = target_startup_.lastDetection().rejected;
+  for (int r = 0; r < static_cast<int>(counts.size()); ++r) {
+    if (counts[r] == 0) continue;
+    out << (out.tellp() > 0 ? ", " : "") << toString(static_cast<TargetRejection>(r)) << " "
+        << counts[r];
+  }
+  return out.str();
+}
+
 double TrackerFrontEnd::targetWaitS() const {
   if (target_startup_.found() || target_wait_start_ns_ == 0) return 0;
   return static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;

@@ -79,6 +79,9 @@ class TrackerFrontEnd {
   bool targetFound() const { return target_startup_.found(); }
   // Why the last image gave no target (empty once found or before any image).
   std::string targetReason() const;
+  // The last image's candidates by rejection ("weak edge 12, bright surround 2"): which
+  // check fails most tells what to fix (light, background, distance).
+  std::string targetRejections() const;
   // Seconds of images without a target (stamps), 0 once found.
   double targetWaitS() const;
   // Past target_timeout_s without a target while images arrive.

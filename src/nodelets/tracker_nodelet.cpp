@@ -163,6 +163,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       // What to fix at the robot: light, background, distance (docs/start_up.md).
       status.add("target type", front_.params().target.target_type);
       status.add("target: last rejection", front_.targetReason());
+      status.add("target: candidates rejected (last image)", front_.targetRejections());
       status.add("target: waiting (s)", front_.targetWaitS());
       status.add("target: overdue", no_target);  // past target_timeout_s
     }

@@ -242,4 +242,6 @@ TEST(TrackerFrontEnd, TargetFoundAndConfirmedWithTheCameraInfo) {
   EXPECT_FALSE(square_front.targetFound());
   EXPECT_NE(square_front.targetReason().find("rectified width/height"), std::string::npos)
       << square_front.targetReason();
+  EXPECT_NE(square_front.targetRejections().find("aspect ratio "), std::string::npos)
+      << square_front.targetRejections();
 }
