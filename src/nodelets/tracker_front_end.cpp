@@ -83,7 +83,11 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   info_size_ = error.empty() ? cv::Size(static_cast<int>(info.width), static_cast<int>(info.height))
                              : cv::Size();
   // The sheet's aspect is judged after rectification with the camera's focal length.
-  focal_px_ = error.empty() && info.K[0] > 0 && std::isfinite(info.K[0]) ? info.K[0] : 0;
+  // The tracker sees the raw image: K (camera_info semantics), not P.
+  const bool usable = error.empty() && info.K[0] > 0 && std::isfinite(info.K[0]) &&
+                      std::isfinite(info.K[2]) && std::isfinite(info.K[5]);
+  focal_px_ = usable ? info.K[0] : 0;
+  principal_px_ = usable ? cv::Point2d(info.K[2], info.K[5]) : cv::Point2d(-1, -1);
   return error;
 }
 
@@ -206,7 +210,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     if (target_wait_start_ns_ == 0 || stamp_ns < target_wait_start_ns_)
       target_wait_start_ns_ = stamp_ns;
     target_wait_last_ns_ = stamp_ns;
-    if (const auto target = target_startup_.process(image, tracker_, focal_px_)) {
+    if (const auto target = target_startup_.process(image, tracker_, focal_px_, principal_px_)) {
       std::ostringstream what;
       what << "start-up target (" << params_.target.target_type << ") confirmed in "
            << params_.target.confirm_frames << " consecutive images";

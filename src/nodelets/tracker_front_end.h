@@ -97,6 +97,7 @@ class TrackerFrontEnd {
   std::string last_frame_id_;
   cv::Size info_size_;
   double focal_px_ = 0;            // from camera_info (K), 0 when unknown
+  cv::Point2d principal_px_{-1, -1};  // from camera_info (K), negative when unknown
   uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
   uint64_t target_wait_last_ns_ = 0;
   GapCounter gaps_;

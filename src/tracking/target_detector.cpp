@@ -473,8 +473,11 @@ std::optional<Rectified> rectify(const cv::Mat& H, double f) {
   return Rectified{n1 / n2, r1.dot(r2) / (n1 * n2)};
 }
 
-cv::Mat squareToQuad(const Quad& quad, cv::Size image) {
-  const cv::Point2f c(image.width / 2.0f, image.height / 2.0f);
+// Centred on the principal point (negative: the image centre).
+cv::Mat squareToQuad(const Quad& quad, cv::Size image, cv::Point2d principal) {
+  const cv::Point2f c = principal.x >= 0 && principal.y >= 0
+                            ? cv::Point2f(principal)
+                            : cv::Point2f(image.width / 2.0f, image.height / 2.0f);
   std::vector<cv::Point2f> square{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, centred;
   for (const auto& p : quad) centred.push_back(p - c);
   return cv::getPerspectiveTransform(square, centred);
@@ -482,8 +485,9 @@ cv::Mat squareToQuad(const Quad& quad, cv::Size image) {
 
 }  // namespace
 
-std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double focal_px) {
-  const cv::Mat H = squareToQuad(quad, image);
+std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double focal_px,
+                                      cv::Point2d principal_px) {
+  const cv::Mat H = squareToQuad(quad, image, principal_px);
   if (H.empty()) return std::nullopt;
   double f = focal_px;
   const double fallback = std::max(image.width, image.height);  // ~53 deg field of view
@@ -513,8 +517,8 @@ namespace {
 // the quadrilateral a rectangle (sides within 9 deg of square) of the sheet's shape.
 // Returns the relative aspect error of the best focal length, and its aspect.
 std::pair<double, double> aspectError(const Quad& quad, cv::Size image, double focal_px,
-                                      double expected) {
-  const cv::Mat H = squareToQuad(quad, image);
+                                      cv::Point2d principal_px, double expected) {
+  const cv::Mat H = squareToQuad(quad, image, focal_px > 0 ? principal_px : cv::Point2d(-1, -1));
   std::pair<double, double> best{std::numeric_limits<double>::infinity(), 0};
   if (H.empty()) return best;
   auto consider = [&](double f, bool need_square) {
@@ -551,12 +555,13 @@ std::string targetParamsError(const TargetParams& p) {
 }
 
 TargetDetection detectConfiguredTarget(const cv::Mat& gray, const TargetParams& params,
-                                       double focal_px) {
+                                       double focal_px, cv::Point2d principal_px) {
   if (params.target_type == "aruco") return detectMarkerTarget(gray, params);
-  return detectTarget(gray, params, focal_px);
+  return detectTarget(gray, params, focal_px, principal_px);
 }
 
-TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, double focal_px) {
+TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, double focal_px,
+                             cv::Point2d principal_px) {
   TargetDetection out;
   if (gray.empty() || gray.type() != CV_8UC1) {
     out.rejection = TargetRejection::kBadImage;
@@ -631,8 +636,9 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
              c.area);
       continue;
     }
-    const auto [aspect_error, a] = aspectError(*refined, gray.size(), focal_px, expected);
-    const auto aspect = rectifiedAspect(*refined, gray.size(), focal_px);
+    const auto [aspect_error, a] =
+        aspectError(*refined, gray.size(), focal_px, principal_px, expected);
+    const auto aspect = rectifiedAspect(*refined, gray.size(), focal_px, principal_px);
     if (!aspect || !(aspect_error <= params.max_aspect_error)) {
       std::ostringstream why;
       why.precision(3);

@@ -15,9 +15,10 @@ void TargetStartup::reset() {
 }
 
 std::optional<TargetDetection> TargetStartup::process(const cv::Mat& gray, FeatureTracker& tracker,
-                                                      double focal_px) {
+                                                      double focal_px,
+                                                      cv::Point2d principal_px) {
   if (found_) return {};
-  TargetDetection target = detectConfiguredTarget(gray, params_, focal_px);
+  TargetDetection target = detectConfiguredTarget(gray, params_, focal_px, principal_px);
   if (!target.found) {
     consecutive_ = 0;
     previous_.release();

@@ -413,6 +413,20 @@ TEST(TargetDetector, RectifiedAspectOfAKnownView) {
   const auto estimated = rectifiedAspect(quad, {640, 480}, 0);
   ASSERT_TRUE(estimated);
   EXPECT_NEAR(*estimated, 0.297 / 0.210, 0.02);
+  // A camera whose principal point is far from the image centre (camera_info's cx, cy):
+  // given, the aspect is right; assumed at the centre, it is not.
+  CameraModel off;
+  off.cx = 200;
+  off.cy = 330;
+  for (int i = 0; i < 4; ++i) {
+    const cv::Vec3d x = Ry * R * cv::Vec3d(map[i].x, map[i].y, 0) + cv::Vec3d(0, 0, 1);
+    quad[i] = off.project(x);
+  }
+  const auto with_pp = rectifiedAspect(quad, {640, 480}, off.fx, {off.cx, off.cy});
+  const auto centred = rectifiedAspect(quad, {640, 480}, off.fx);
+  ASSERT_TRUE(with_pp && centred);
+  EXPECT_NEAR(*with_pp, 0.297 / 0.210, 0.01);
+  EXPECT_GT(std::abs(*centred - 0.297 / 0.210), 0.03) << *centred;
 }
 
 TEST(TargetDetector, RejectionsSayWhy) {

@@ -72,19 +72,21 @@ struct TargetDetection {
 // global thresholds, an adaptive threshold and the outlines of edges; each must show a
 // step over the noise on all four sides, a dark surround, and after rectification the
 // sheet's width/height. focal_px: the camera's focal length (0: estimated from the
-// quadrilateral, principal point at the image centre).
+// quadrilateral); principal_px: its principal point (negative: the image centre).
 TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params = TargetParams(),
-                             double focal_px = 0);
+                             double focal_px = 0, cv::Point2d principal_px = {-1, -1});
 
 // The configured target (params.target_type): the sheet or the ArUco marker.
 TargetDetection detectConfiguredTarget(const cv::Mat& gray, const TargetParams& params,
-                                       double focal_px = 0);
+                                       double focal_px = 0,
+                                       cv::Point2d principal_px = {-1, -1});
 
 // Width/height of the rectangle whose image is `quad` (in order around it, side 0-1 is a
 // width), from the homography and the focal length (0: estimated). Nothing when the
 // quadrilateral cannot be the image of a rectangle in front of the camera.
 std::optional<double> rectifiedAspect(const std::array<cv::Point2f, 4>& quad, cv::Size image,
-                                      double focal_px = 0);
+                                      double focal_px = 0,
+                                      cv::Point2d principal_px = {-1, -1});
 
 // The target's corners in the map frame, in TargetDetection's order (sheet: width x
 // height; aruco: the marker's square).

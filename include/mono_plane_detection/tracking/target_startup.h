@@ -20,9 +20,11 @@ class TargetStartup {
   explicit TargetStartup(const TargetParams& params = TargetParams()) : params_(params) {}
 
   // Call after tracker.process(gray). Returns the detection on the image where the target
-  // is confirmed (once); nothing before and after. focal_px: 0 when unknown.
+  // is confirmed (once); nothing before and after. focal_px: 0 when unknown;
+  // principal_px: negative for the image centre.
   std::optional<TargetDetection> process(const cv::Mat& gray, FeatureTracker& tracker,
-                                         double focal_px = 0);
+                                         double focal_px = 0,
+                                         cv::Point2d principal_px = {-1, -1});
 
   bool found() const { return found_; }
   void reset();  // search again (the tracker was reset)
