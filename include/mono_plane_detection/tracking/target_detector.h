@@ -19,10 +19,11 @@ struct TargetParams {
   double width_m = 0.297;             // the sheet, the longer side
   double height_m = 0.210;
   double min_area_px = 400;  // smaller candidates are ignored
-  // The sheet's corners: the mean brightness just outside each side over just inside.
-  // Measured on the development photos (test/data/target_photos): dark and mid-brown
-  // wood 0.12-0.36, the sunlit table of test2 0.41; light wood (test4) 0.68, which leaves
-  // no usable edge under uneven light. 0.45 keeps the first, refuses the second.
+  // Surround over sheet brightness just outside / inside its outline (median along it).
+  // Measured on the development photos (test/data/target_photos): dark wood 0.14, brown
+  // wood 0.28-0.31, the half-sunlit table of test2 0.32; light wood (test4) 0.69-0.70,
+  // whose edge with paper is weak under uneven light. 0.45 keeps the first, refuses the
+  // last, with room for a darker or lighter shade of each.
   double max_surround_ratio = 0.45;
   // Each side's brightness step, over the image noise's standard deviation (estimated
   // per image): a real sheet edge is tens of sigmas; texture edges are a few.
