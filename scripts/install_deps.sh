@@ -16,7 +16,7 @@ PACKAGES=(
   libgeometry-msgs-dev ros-geometry-msgs libtf2-msgs-dev ros-tf2-msgs python3-tf2-msgs
   libtf2-dev libtf2-ros-dev python3-tf2-ros libvisualization-msgs-dev ros-visualization-msgs
   python3-geometry-msgs python3-visualization-msgs
-  libyaml-cpp-dev libopencv-dev libeigen3-dev libboost-program-options-dev
+  libyaml-cpp-dev libopencv-dev libopencv-contrib-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
   libstd-srvs-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure

@@ -82,12 +82,46 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   const std::string error = cameraInfoError(info);
   info_size_ = error.empty() ? cv::Size(static_cast<int>(info.width), static_cast<int>(info.height))
                              : cv::Size();
+  // The sheet's aspect is judged after rectification with the camera's focal length.
+  // The tracker sees the raw image: K (camera_info semantics), not P.
+  const bool usable = error.empty() && info.K[0] > 0 && std::isfinite(info.K[0]) &&
+                      std::isfinite(info.K[2]) && std::isfinite(info.K[5]);
+  focal_px_ = usable ? info.K[0] : 0;
+  principal_px_ = usable ? cv::Point2d(info.K[2], info.K[5]) : cv::Point2d(-1, -1);
   return error;
+}
+
+std::string TrackerFrontEnd::targetReason() const {
+  if (target_startup_.found()) return {};
+  return target_startup_.lastDetection().reason;
+}
+
+std::string TrackerFrontEnd::targetRejections() const {
+  if (target_startup_.found()) return {};
+  std::ostringstream out;
+  const auto& counts = target_startup_.lastDetection().rejected;
+  for (int r = 0; r < static_cast<int>(counts.size()); ++r) {
+    if (counts[r] == 0) continue;
+    out << (out.tellp() > 0 ? ", " : "") << toString(static_cast<TargetRejection>(r)) << " "
+        << counts[r];
+  }
+  return out.str();
+}
+
+double TrackerFrontEnd::targetWaitS() const {
+  if (target_startup_.found() || target_wait_start_ns_ == 0) return 0;
+  return static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
+}
+
+bool TrackerFrontEnd::targetOverdue() const {
+  return params_.detect_target && !target_startup_.found() &&
+         targetWaitS() > params_.target_timeout_s;
 }
 
 void TrackerFrontEnd::reset() {
   tracker_.reset();
   target_startup_.reset();
+  target_wait_start_ns_ = target_wait_last_ns_ = 0;
   last_stamp_ns_ = 0;
   last_size_ = cv::Size();
   last_frame_id_.clear();
@@ -170,12 +204,26 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   tracker_.process(image);
   // Paper II-A: until the start-up target is seen, look for it; its corners become
   // tracked points flagged as target corners.
-  if (params_.detect_target) {
-    if (const auto target = target_startup_.process(image, tracker_)) {
+  if (params_.detect_target && !target_startup_.found()) {
+    // The wait counts from the first image searched (after a reset too: the reset
+    // already said why), in image stamps.
+    if (target_wait_start_ns_ == 0 || stamp_ns < target_wait_start_ns_)
+      target_wait_start_ns_ = stamp_ns;
+    target_wait_last_ns_ = stamp_ns;
+    if (const auto target = target_startup_.process(image, tracker_, focal_px_, principal_px_)) {
       std::ostringstream what;
-      what << "start-up target found (" << std::lround(target->contrast)
-           << " grey levels of contrast)";
+      what << "start-up target (" << params_.target.target_type << ") confirmed in "
+           << params_.target.confirm_frames << " consecutive images";
+      if (params_.target.target_type == "sheet")
+        what << " (" << std::lround(target->contrast) << " grey levels of contrast)";
       out.infos.push_back(what.str());
+    } else if (targetOverdue()) {
+      std::ostringstream why;
+      why.precision(1);
+      why << std::fixed << "no start-up target (" << params_.target.target_type << ") for "
+          << targetWaitS() << " s: " << targetReason()
+          << "; planes stay in image space until one is seen";
+      out.warnings.push_back({"target timeout", why.str()});
     }
   }
   const TrackerFrameStats& stats = tracker_.lastStats();

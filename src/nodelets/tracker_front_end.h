@@ -77,6 +77,15 @@ class TrackerFrontEnd {
   const TrackerCounts& counts() const { return counts_; }
   bool hasCameraInfo() const { return !info_size_.empty(); }
   bool targetFound() const { return target_startup_.found(); }
+  // Why the last image gave no target (empty once found or before any image).
+  std::string targetReason() const;
+  // The last image's candidates by rejection ("weak edge 12, bright surround 2"): which
+  // check fails most tells what to fix (light, background, distance).
+  std::string targetRejections() const;
+  // Seconds of images without a target (stamps), 0 once found.
+  double targetWaitS() const;
+  // Past target_timeout_s without a target while images arrive.
+  bool targetOverdue() const;
   const TrackerNodeParams& params() const { return params_; }
 
  private:
@@ -87,6 +96,10 @@ class TrackerFrontEnd {
   cv::Size last_size_;
   std::string last_frame_id_;
   cv::Size info_size_;
+  double focal_px_ = 0;            // from camera_info (K), 0 when unknown
+  cv::Point2d principal_px_{-1, -1};  // from camera_info (K), negative when unknown
+  uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
+  uint64_t target_wait_last_ns_ = 0;
   GapCounter gaps_;
   TrackerCounts counts_;
 };

@@ -95,6 +95,13 @@ class TrackerNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(state_mutex_);
       out = front_.process(msg);
       for (const LogEvent& event : out.warnings) warn(event);
+      // Before target_timeout_s: why the target is not seen yet, now and then (after it, a
+      // WARN says so every 5 s).
+      if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
+          !front_.targetOverdue())
+        NODELET_INFO_THROTTLE(10.0, "waiting for the start-up target (%s): %s",
+                              front_.params().target.target_type.c_str(),
+                              front_.targetReason().c_str());
       if (!out.tracks) {
         if (out.dropped_is_error)
           NODELET_ERROR_THROTTLE(5.0, "dropping image: %s", out.dropped.c_str());
@@ -131,13 +138,15 @@ class TrackerNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const TrackerCounts& c = front_.counts();
     const long exceptions = guard_.count();
-    const bool warn = c.dropped > 0 || c.camera_switches > 0 || exceptions > 0;
+    const bool no_target = front_.targetOverdue();
+    const bool warn = c.dropped > 0 || c.camera_switches > 0 || exceptions > 0 || no_target;
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
                    : c.camera_switches > 0 ? "image stream mixes cameras"
                    : c.dropped > 0         ? "images dropped"
-                                           : "tracking");
+                   : no_target            ? "no start-up target: " + front_.targetReason()
+                                           : std::string("tracking"));
     status.add("points tracked", c.tracked_now);
     status.add("points lost (total)", c.lost);
     status.add("searches (total)", c.searches);
@@ -150,6 +159,14 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
+    if (front_.params().detect_target && !front_.targetFound()) {
+      // What to fix at the robot: light, background, distance (docs/start_up.md).
+      status.add("target type", front_.params().target.target_type);
+      status.add("target: last rejection", front_.targetReason());
+      status.add("target: candidates rejected (last image)", front_.targetRejections());
+      status.add("target: waiting (s)", front_.targetWaitS());
+      status.add("target: overdue", no_target);  // past target_timeout_s
+    }
   }
 
   CallbackGuard guard_;  // first member: the last destroyed

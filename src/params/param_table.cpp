@@ -132,15 +132,24 @@ const ParamTable<TargetParams>& targetParamTable() {
       {"width_m", field(&P::width_m), 0.01, 10, "m",
        "start-up target's white rectangle, the longer side", "target_width_m"},
       {"height_m", field(&P::height_m), 0.01, 10, "m", "its shorter side", "target_height_m"},
+      {"target_type", field(&P::target_type), 0, 0, "",
+       "start-up target: sheet (white sheet on a darker surface) or aruco (fiducial marker)"},
       {"min_area_px", field(&P::min_area_px), 1, 1e8, "px^2", "smaller candidates are ignored"},
-      {"max_aspect_distortion", field(&P::max_aspect_distortion), 1, 100, "",
-       "the image's side ratio may differ from width/height by this factor"},
-      {"min_contrast", field(&P::min_contrast), 0, 255, "grey levels",
-       "between the white inside and the dark ring"},
-      {"min_structure", field(&P::min_structure), 0, 1, "",
-       "share of the inside above / the ring below Otsu's level"},
-      {"max_ring_ratio", field(&P::max_ring_ratio), 0, 1, "",
-       "the dark border's mean over the white inside's mean"},
+      {"max_surround_ratio", field(&P::max_surround_ratio), 0.01, 1, "",
+       "sheet: surround over sheet brightness along its outline (median), at most"},
+      {"min_edge_snr", field(&P::min_edge_snr), 0, 1000, "",
+       "sheet: each side's brightness step in noise standard deviations, at least"},
+      {"max_aspect_error", field(&P::max_aspect_error), 0.001, 1, "",
+       "sheet: rectified width/height vs width_m/height_m, relative error allowed"},
+      {"dictionary", field(&P::dictionary), 0, 0, "",
+       "aruco: OpenCV predefined dictionary (DICT_4X4_50, DICT_6X6_250, ...)"},
+      {"marker_id", field(&P::marker_id), 0, 999, "", "aruco: the marker's id"},
+      {"marker_size_m", field(&P::marker_size_m), 0.005, 10, "m",
+       "aruco: printed side of the black square"},
+      {"confirm_frames", field(&P::confirm_frames), 1, 1000, "",
+       "consecutive images with consistently tracked corners before the target fixes the map"},
+      {"confirm_tolerance_px", field(&P::confirm_tolerance_px), 0.01, 100, "px",
+       "detected vs Lucas-Kanade-tracked corner, largest distance, to count as consistent"},
   };
   return table;
 }
@@ -295,6 +304,9 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
                  "look for the start-up target (paper II-A) until found"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
                  "a longer pause between images is a tracking loss (start over)"});
+    t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0.1, 1e6, "s",
+                 "diagnostics WARN (with the reason) when images arrive this long without a "
+                 "start-up target"});
     t.push_back({"image_transport", field(&P::image_transport), 0, 0, "",
                  "image_transport hint for the image"});
     t.push_back({"expected_min_rate_hz", field(&P::expected_min_rate_hz), 0, 1e6, "Hz",
@@ -463,15 +475,29 @@ std::vector<std::string> validate(PipelineParams& params) {
   return validate(params, pipelineParamTable());
 }
 
+// Names the table cannot range-check: target_type, dictionary, marker_id within it.
+static void checkTargetNames(TargetParams& p, std::vector<std::string>& errors) {
+  const std::string error = targetParamsError(p);
+  if (error.empty()) return;
+  const TargetParams d;
+  errors.push_back("target/" + error + "; using the defaults target_type " + d.target_type +
+                   ", dictionary " + d.dictionary + ", marker_id " + std::to_string(d.marker_id));
+  p.target_type = d.target_type;
+  p.dictionary = d.dictionary;
+  p.marker_id = d.marker_id;
+}
+
 std::vector<std::string> validate(TrackerNodeParams& params) {
   auto errors = validate(params, trackerNodeParamTable());
   checkRateWindow(params, errors);
+  checkTargetNames(params.target, errors);
   return errors;
 }
 
 std::vector<std::string> validate(PlaneNodeParams& params) {
   auto errors = validate(params, planeNodeParamTable());
   checkRateWindow(params, errors);
+  checkTargetNames(params.pipeline.target, errors);
   return errors;
 }
 

@@ -17,7 +17,9 @@
 #include "cli_args.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/planes/homography_voting.h"
+#include "mono_plane_detection/sim/scene_renderer.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
+#include "mono_plane_detection/tracking/target_detector.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
 
 using namespace mono_plane_detection;
@@ -228,6 +230,55 @@ void plot(const std::vector<PlaneRow>& planes,
   cv::imwrite(path, img);
 }
 
+// Start-up target search per 640x480 rendered view (the room along the wheeled path, the
+// sheet in view in the first images, not later): the sheet detector, the ArUco detector
+// (no marker in view: its full search) and the plain baseline every quadrilateral search
+// starts from (Otsu, contours, approxPolyDP, convexity).
+void benchTargets(int views) {
+  RoomParams room;
+  const IndoorScene scene = makeRoom(room);
+  RenderOptions options;
+  options.noise_sigma = 2;
+  const CameraModel camera;
+  const SceneRenderer renderer(scene, camera, options);
+  TrajectoryParams path;
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < views; ++i)
+    images.push_back(renderer.render(trajectoryPose(path, 10.0 * i / views), i));
+  TargetParams marker;
+  marker.target_type = "aruco";
+  std::vector<double> sheet_ms, marker_ms, base_ms;
+  int found = 0;
+  for (const cv::Mat& image : images) {
+    auto start = Clock::now();
+    found += detectTarget(image, TargetParams(), camera.fx).found ? 1 : 0;
+    sheet_ms.push_back(msSince(start));
+    start = Clock::now();
+    detectConfiguredTarget(image, marker);
+    marker_ms.push_back(msSince(start));
+    start = Clock::now();
+    cv::Mat binary;
+    cv::threshold(image, binary, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(binary, contours, cv::RETR_LIST, cv::CHAIN_APPROX_SIMPLE);
+    int quads = 0;
+    for (const auto& c : contours) {
+      std::vector<cv::Point> q;
+      cv::approxPolyDP(c, q, 0.03 * cv::arcLength(c, true), true);
+      quads += q.size() == 4 && cv::isContourConvex(q);
+    }
+    base_ms.push_back(msSince(start) + 0 * quads);
+  }
+  const Stats sheet = stats(sheet_ms), aruco = stats(marker_ms), base = stats(base_ms);
+  std::printf(
+      "\nStart-up target search, 640x480 rendered views (%d, sheet found in %d), ms per\n"
+      "image mean / p95:\n"
+      "  sheet (ours)              %6.2f / %6.2f\n"
+      "  aruco (OpenCV, no marker) %6.2f / %6.2f\n"
+      "  baseline (Otsu + contours + approxPolyDP) %6.2f / %6.2f\n",
+      views, found, sheet.mean, sheet.p95, aruco.mean, aruco.p95, base.mean, base.p95);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -277,6 +328,7 @@ int main(int argc, char** argv) {
         r.baseline.p95, r.ours.mean / r.baseline.mean, r.ours_nodelet.mean / r.baseline.mean,
         r.our_error, r.nodelet_error, r.baseline_error);
   }
+  benchTargets(std::max(20, count / 2));
   plot(rows, tracker_vga, plot_path);
   std::printf("\nplot: %s\n", plot_path.c_str());
   return 0;

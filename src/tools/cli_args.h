@@ -162,6 +162,14 @@ class Parser {
     return *this;
   }
 
+  // Every remaining argument that is not an option (last, after the single positionals):
+  // "IMAGE...". Required: at least one.
+  Parser& positionals(const std::string& name, std::vector<std::string>* target,
+                      const std::string& help, bool required = true) {
+    positionals_.push_back({name, help, required, nullptr, target});
+    return *this;
+  }
+
   // Exit code to return now (0 after --help, 2 after a usage error, with the reason and
   // the usage on stderr), or nothing: the targets are set, go on.
   std::optional<int> parse(int argc, const char* const* argv) {
@@ -188,8 +196,13 @@ class Parser {
     }
     po::positional_options_description order;
     for (const Positional& p : positionals_) {
-      adder(p.name.c_str(), po::value<std::string>(), "");
-      order.add(p.name.c_str(), 1);
+      if (p.rest) {
+        adder(p.name.c_str(), po::value<std::vector<std::string>>(), "");
+        order.add(p.name.c_str(), -1);
+      } else {
+        adder(p.name.c_str(), po::value<std::string>(), "");
+        order.add(p.name.c_str(), 1);
+      }
     }
     po::variables_map values;
     try {
@@ -214,7 +227,13 @@ class Parser {
       if (!why.empty()) throw UsageError("--" + o.name + " " + why);
     }
     for (const Positional& p : positionals_) {
-      if (values.count(p.name))
+      if (p.rest && values.count(p.name))
+        *p.rest = values[p.name].as<std::vector<std::string>>();
+      else if (p.rest && p.required)
+        throw UsageError("missing " + p.name);
+      else if (p.rest)
+        continue;
+      else if (values.count(p.name))
         *p.target = values[p.name].as<std::string>();
       else if (p.required)
         throw UsageError("missing " + p.name);
@@ -269,6 +288,7 @@ class Parser {
     std::string name, help;
     bool required;
     std::string* target;
+    std::vector<std::string>* rest = nullptr;  // takes every remaining argument
   };
 
   void add(const std::string& name, const std::string& value_name, const std::string& help,

@@ -253,3 +253,60 @@ TEST(OdometryCheck, NonFiniteOrJumpingOdometryIsRefused) {
   nan_rotation.R(0, 0) = std::nan("");
   EXPECT_NE(odometryError(nan_rotation, odom, 1.0), "");
 }
+
+// Issue 12, bad input: a target that is never found. Images keep being tracked; after
+// target_timeout_s of image stamps the front end warns with the detector's reason, and
+// the diagnostics' state (targetOverdue, targetReason) says it.
+TEST(TrackerFrontEnd, NoTargetWarnsAfterTheTimeoutWithTheReason) {
+  TrackerNodeParams params;
+  params.target_timeout_s = 2.0;
+  TrackerFrontEnd front(params);
+  const cv::Mat grey = textured({320, 240});
+  bool warned_early = false, warned = false;
+  for (int k = 0; k <= 30; ++k) {  // 10 Hz, 3 s
+    const TrackerOutput out = front.process(image(grey, 100 + k / 10, (k % 10) * 100000000));
+    ASSERT_TRUE(out.tracks) << out.dropped;
+    for (const LogEvent& e : out.warnings) {
+      if (e.kind != "target timeout") continue;
+      (k <= 20 ? warned_early : warned) = true;
+      EXPECT_NE(e.text.find(front.targetReason()), std::string::npos) << e.text;
+    }
+    EXPECT_EQ(front.targetOverdue(), k > 20) << k;
+  }
+  EXPECT_FALSE(warned_early);
+  EXPECT_TRUE(warned);
+  EXPECT_FALSE(front.targetFound());
+  EXPECT_FALSE(front.targetReason().empty());
+  EXPECT_NEAR(front.targetWaitS(), 3.0, 1e-6);
+  front.reset();  // nobody listens: the wait starts again
+  EXPECT_FALSE(front.targetOverdue());
+  EXPECT_EQ(front.targetWaitS(), 0.0);
+}
+
+// The focal length from camera_info reaches the detector: a square seen head-on is not an
+// A4 sheet once the focal length is known (without it, some focal length would make it
+// one seen obliquely).
+TEST(TrackerFrontEnd, TargetFoundAndConfirmedWithTheCameraInfo) {
+  TrackerNodeParams params;
+  TrackerFrontEnd front(params);
+  EXPECT_EQ(front.setCameraInfo(cameraInfo({0, 0, 0, 0, 0})), "");
+  cv::Mat sheet(480, 640, CV_8UC1, cv::Scalar(30));
+  sheet(cv::Rect(200, 150, 212, 150)).setTo(230);
+  int found_at = -1;
+  for (int k = 0; k < 5 && found_at < 0; ++k) {
+    const TrackerOutput out = front.process(image(sheet, 100, k * 100000000));
+    ASSERT_TRUE(out.tracks);
+    if (front.targetFound()) found_at = k;
+  }
+  EXPECT_EQ(found_at, params.target.confirm_frames - 1);
+  TrackerFrontEnd square_front(params);
+  square_front.setCameraInfo(cameraInfo({0, 0, 0, 0, 0}));
+  cv::Mat square(480, 640, CV_8UC1, cv::Scalar(30));
+  square(cv::Rect(220, 140, 200, 200)).setTo(230);
+  for (int k = 0; k < 5; ++k) square_front.process(image(square, 100, k * 100000000));
+  EXPECT_FALSE(square_front.targetFound());
+  EXPECT_NE(square_front.targetReason().find("rectified width/height"), std::string::npos)
+      << square_front.targetReason();
+  EXPECT_NE(square_front.targetRejections().find("aspect ratio "), std::string::npos)
+      << square_front.targetRejections();
+}

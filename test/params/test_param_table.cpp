@@ -41,7 +41,7 @@ TEST(ParamTable, DefaultsAreInRangeAndNamesUnique) {
   expectSound(trackerNodeParamTable());
   expectSound(planeNodeParamTable());
   EXPECT_EQ(trackerNodeParamTable().size(),
-            trackerParamTable().size() + targetParamTable().size() + 6);
+            trackerParamTable().size() + targetParamTable().size() + 7);  // + target_timeout_s
 }
 
 TEST(ParamTable, NestedNamesReachTheNestedFields) {
@@ -157,4 +157,27 @@ TEST(ParamTable, ConfigFilesUseKnownNamesInRange) {
   }
   closedir(d);
   EXPECT_EQ(files, 6);
+}
+
+// Issue 12: target_type and the marker's dictionary are names the ranges cannot check:
+// an unknown one is an error naming it, and the defaults are used.
+TEST(ParamTable, UnknownTargetTypeOrDictionaryFallsBack) {
+  TrackerNodeParams p;
+  p.target.target_type = "checkerboard";
+  auto errors = validate(p);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("checkerboard"), std::string::npos) << errors[0];
+  EXPECT_EQ(p.target.target_type, "sheet");
+  PlaneNodeParams q;
+  q.pipeline.target.target_type = "aruco";
+  q.pipeline.target.dictionary = "DICT_9X9_1";
+  errors = validate(q);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("DICT_9X9_1"), std::string::npos) << errors[0];
+  EXPECT_EQ(q.pipeline.target.dictionary, "DICT_4X4_50");
+  TrackerNodeParams ok;
+  ok.target.target_type = "aruco";
+  ok.target.marker_id = 12;
+  EXPECT_TRUE(validate(ok).empty());
+  EXPECT_EQ(ok.target.target_type, "aruco");
 }

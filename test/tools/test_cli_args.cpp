@@ -149,3 +149,23 @@ TEST(CliArgs, HelpComesFromTheTableAndExitsZero) {
   EXPECT_EQ(*bad_code, 2);
   EXPECT_NE(complaint.find("usage: prog"), std::string::npos);
 }
+
+// detect_target IMAGE...: every remaining argument, options before or after them.
+TEST(CliArgs, VariadicPositionalsTakeEveryRemainingArgument) {
+  std::vector<std::string> images;
+  bool json = false;
+  Parser p("prog", "[options] IMAGE...", "");
+  p.positionals("IMAGE", &images, "images").flag("json", &json, "JSON");
+  EXPECT_TRUE(parse(p, {"a.png", "--json", "b.png", "c.jpg"}));
+  EXPECT_EQ(images, (std::vector<std::string>{"a.png", "b.png", "c.jpg"}));
+  EXPECT_TRUE(json);
+  std::vector<std::string> none;
+  Parser q("prog", "IMAGE...", "");
+  q.positionals("IMAGE", &none, "images");
+  EXPECT_THROW(parse(q, {}), cli::UsageError);  // at least one
+  std::vector<std::string> optional;
+  Parser r("prog", "[IMAGE...]", "");
+  r.positionals("IMAGE", &optional, "images", false);
+  EXPECT_TRUE(parse(r, {}));
+  EXPECT_TRUE(optional.empty());
+}

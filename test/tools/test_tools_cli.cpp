@@ -19,6 +19,7 @@ namespace {
 const std::vector<std::pair<std::string, std::string>> kTools = {
     {"benchmark_latency", BENCHMARK_LATENCY_PATH}, {"benchmark_suite", BENCHMARK_SUITE_PATH},
     {"benchmark_tracker", BENCHMARK_TRACKER_PATH}, {"demo_report", DEMO_REPORT_PATH},
+    {"detect_target", DETECT_TARGET_PATH},
     {"make_sequence", MAKE_SEQUENCE_PATH},         {"run_pipeline", RUN_PIPELINE_PATH},
     {"segment_planes", SEGMENT_PLANES_PATH}};
 
@@ -84,4 +85,31 @@ TEST(ToolsCli, DocsToolsPageIsEveryToolsHelp) {
   committed << std::ifstream(doc).rdbuf();
   EXPECT_EQ(committed.str(), page) << "docs/tools.md is out of date: MPD_WRITE_TOOLS_DOC=1 "
                                       "devel/lib/mono_plane_detection/test_tools_cli";
+}
+
+// Issue 12: detect_target prints per image the corners or `none` and the reason (--json
+// too); exit 0 when it ran, 2 on bad usage or an unreadable image.
+TEST(ToolsCli, DetectTargetOnRealPhotos) {
+  const std::string photos = std::string(TEST_DATA_DIR) + "/target_photos/";
+  ProgramRun r = run(DETECT_TARGET_PATH, photos + "test1.jpg " + photos + "test4.jpg");
+  EXPECT_EQ(r.code, 0) << r.err;
+  // test1: found, four corners; test4 (light wood): none, with the reason.
+  EXPECT_NE(r.out.find("test1.jpg: "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("test1.jpg: none"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("test4.jpg: none (bright surround"), std::string::npos) << r.out;
+  r = run(DETECT_TARGET_PATH, "--json " + photos + "test3.jpg " + photos + "result.jpg");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"found\": true, \"corners\": [["), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"found\": false, \"rejection\""), std::string::npos) << r.out;
+  r = run(DETECT_TARGET_PATH, "--target-type aruco " + photos + "test1.jpg");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("none (no marker"), std::string::npos) << r.out;
+  r = run(DETECT_TARGET_PATH, "/no/such/image.png");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("cannot read image"), std::string::npos) << r.err;
+  EXPECT_EQ(run(DETECT_TARGET_PATH, "").code, 2);  // no image
+  EXPECT_EQ(run(DETECT_TARGET_PATH, "--target-type checkerboard " + photos + "test1.jpg").code, 2);
+  EXPECT_EQ(run(DETECT_TARGET_PATH, "--target-type aruco --dictionary DICT_9X9_1 " + photos +
+                                        "test1.jpg").code,
+            2);
 }

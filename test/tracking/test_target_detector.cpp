@@ -1,7 +1,12 @@
 // The start-up target in rendered views with exact ground truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "mono_plane_detection/sim/scene_renderer.h"
 #include "mono_plane_detection/tracking/target_detector.h"
@@ -158,4 +163,293 @@ TEST(TargetDetector, PoseNeedsUsableIntrinsics) {
   const auto map = targetCornersInMap(TargetParams());
   EXPECT_DOUBLE_EQ(map[2].x - map[0].x, 0.297);
   EXPECT_DOUBLE_EQ(map[2].y - map[0].y, 0.210);
+}
+
+// ---------------------------------------------------------------------------------------
+// Real photos (test/data/target_photos, README there): the sheets labelled by hand.
+
+namespace {
+
+struct Labelled {
+  std::string file;
+  TargetParams params;  // the paper's size
+  std::array<cv::Point2f, 4> corners;  // in the stored file's pixels, around the sheet
+};
+
+std::vector<Labelled> readLabels() {
+  std::vector<Labelled> out;
+  std::ifstream in(std::string(TEST_DATA_DIR) + "/target_photos/labels.csv");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream row(line);
+    Labelled l;
+    std::string paper;
+    row >> l.file >> paper;
+    if (paper == "letter") {
+      l.params.width_m = 0.2794;
+      l.params.height_m = 0.2159;
+    }
+    for (auto& c : l.corners) row >> c.x >> c.y;
+    out.push_back(l);
+  }
+  return out;
+}
+
+cv::Mat loadAtWidth(const std::string& path, int width, double* scale) {
+  const cv::Mat original = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (original.empty()) return original;
+  *scale = static_cast<double>(width) / original.cols;
+  cv::Mat out;
+  cv::resize(original, out, cv::Size(), *scale, *scale,
+             *scale < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return out;
+}
+
+// Largest corner distance (px of the stored file) for the best correspondence of two
+// quadrilaterals given in order around them (either direction, any start).
+double worstCornerError(const std::array<cv::Point2f, 4>& a, const std::array<cv::Point2f, 4>& b,
+                        double* mean) {
+  double best = 1e9;
+  for (int start = 0; start < 4; ++start)
+    for (int dir : {1, -1}) {
+      double worst = 0, sum = 0;
+      for (int i = 0; i < 4; ++i) {
+        const double e = cv::norm(a[i] - b[((start + dir * i) % 4 + 4) % 4]);
+        worst = std::max(worst, e);
+        sum += e;
+      }
+      if (worst < best) {
+        best = worst;
+        *mean = sum / 4;
+      }
+    }
+  return best;
+}
+
+std::vector<std::string> filesIn(const std::string& dir, const std::string& ext) {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ext) out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+// Issue 12: every sheet whose border with the darker surface is visible all round, at 640
+// and 1280 px wide, corners within 2 px (at 640 px) of the hand labels; the focal length
+// of these photos is unknown (0). test4.jpg lies on light wood (surround/sheet 0.69):
+// refused, with that reason.
+TEST(TargetDetectorRealPhotos, FoundWithinTwoPixelsOfTheLabels) {
+  const auto labels = readLabels();
+  ASSERT_EQ(labels.size(), 5u);
+  int found = 0, expected = 0;
+  double worst_all = 0, sum_all = 0;
+  for (const Labelled& l : labels) {
+    for (const int width : {640, 1280}) {
+      double scale = 1;
+      const cv::Mat image = loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + l.file,
+                                        width, &scale);
+      ASSERT_FALSE(image.empty()) << l.file;
+      const TargetDetection d = detectTarget(image, l.params);
+      if (l.file == "test4.jpg") {
+        EXPECT_FALSE(d.found) << "light wood: refused by design";
+        EXPECT_EQ(d.rejection, TargetRejection::kBrightSurround) << d.reason;
+        continue;
+      }
+      ++expected;
+      ASSERT_TRUE(d.found) << l.file << " at " << width << ": " << d.reason;
+      ++found;
+      std::array<cv::Point2f, 4> in_file;
+      for (int i = 0; i < 4; ++i) in_file[i] = d.corners[i] / static_cast<float>(scale);
+      double mean = 0;
+      const double worst = worstCornerError(in_file, l.corners, &mean);
+      // In pixels of the image scaled to 640 px wide.
+      const double to640 = 640.0 / (image.cols / scale);
+      std::printf("%-16s %4d px: mean %.2f, worst %.2f px (at 640), surround/sheet %.2f\n",
+                  l.file.c_str(), width, mean * to640, worst * to640, d.surround_ratio);
+      EXPECT_LT(worst * to640, 2.0) << l.file << " at " << width;
+      worst_all = std::max(worst_all, worst * to640);
+      sum_all += mean * to640;
+    }
+  }
+  std::printf("found %d of %d, mean %.2f px, worst %.2f px (at 640 px width)\n", found, expected,
+              sum_all / std::max(1, found), worst_all);
+  EXPECT_EQ(found, expected);
+}
+
+// Issue 12: never invented on real office frames (TUM RGB-D; the old detector took the
+// black-and-white striped pole of 1341847989.802890 for the sheet), with the camera's
+// focal length and without, at three sizes; nor on flat page scans (no surround).
+TEST(TargetDetectorRealPhotos, NoFalseTargets) {
+  int checked = 0;
+  std::vector<std::string> tum = filesIn(std::string(TEST_DATA_DIR) + "/tum_office", ".jpg");
+  for (const auto& p : filesIn(std::string(TEST_DATA_DIR) + "/tum_office", ".png")) tum.push_back(p);
+  ASSERT_GE(tum.size(), 5u);
+  for (const std::string& path : tum) {
+    for (const int width : {320, 640, 1280}) {
+      double scale = 1;
+      const cv::Mat image = loadAtWidth(path, width, &scale);
+      ASSERT_FALSE(image.empty()) << path;
+      for (const double focal : {0.0, 535.4 * scale}) {
+        const TargetDetection d = detectTarget(image, TargetParams(), focal);
+        EXPECT_FALSE(d.found) << path << " at " << width << " px, focal " << focal;
+        EXPECT_FALSE(d.reason.empty());
+        ++checked;
+      }
+    }
+  }
+  for (const std::string name : {"result.jpg", "scanned_img.jpg"}) {
+    for (const int width : {640, 1280}) {
+      double scale = 1;
+      const cv::Mat image =
+          loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + name, width, &scale);
+      ASSERT_FALSE(image.empty()) << name;
+      for (const bool letter : {false, true}) {
+        TargetParams p;
+        if (letter) p.width_m = 0.2794, p.height_m = 0.2159;
+        EXPECT_FALSE(detectTarget(image, p).found) << name << " at " << width;
+        ++checked;
+      }
+    }
+  }
+  std::printf("%d negative images checked\n", checked);
+}
+
+// Rendered views: every view of the room in which the sheet is not in view gives no
+// target; every view in which all of it (with its border) is in view and it is at least
+// 40 px wide gives it, to sub-pixel. Both trajectories and the in-place rotation, the
+// target on the wall and on the floor, with noise.
+TEST(TargetDetector, RenderedViewsWithAndWithoutTheSheet) {
+  int negatives = 0, false_targets = 0, positives = 0, found = 0;
+  double worst = 0, sum = 0;
+  for (const std::string target_on : {"wall", "floor", "wall-2"}) {
+    RoomParams room;
+    room.target_on = target_on == "floor" ? "floor" : "wall";
+    room.seed = target_on == "wall-2" ? 2 : 1;  // other textures
+    const IndoorScene scene = makeRoom(room);
+    const CameraModel camera;
+    RenderOptions options;
+    options.noise_sigma = 2.0;
+    const SceneRenderer renderer(scene, camera, options);
+    for (const std::string trajectory : {"wheeled", "humanoid", "rotation"}) {
+      TrajectoryParams tp;
+      tp.name = trajectory;
+      if (target_on == "floor") tp.pitch_down_deg = 35;
+      for (double t = 0; t <= 10.0; t += 0.25) {
+        const Pose world_from_camera = trajectoryPose(tp, t);
+        int in_view = 0;
+        double min_x = 1e9, max_x = -1e9;
+        for (const auto& c : scene.target.corners) {
+          const cv::Vec3d x = world_from_camera.inverse().apply(c);
+          const cv::Point2d p = camera.project(x);
+          const bool inside = x[2] > 0 && p.x >= 20 && p.y >= 20 && p.x < 620 && p.y < 460;
+          in_view += inside ? 1 : 0;
+          min_x = std::min(min_x, p.x);
+          max_x = std::max(max_x, p.x);
+          // Any corner in the image at all: not a clean negative.
+          if (x[2] > 0 && p.x >= -50 && p.y >= -50 && p.x < 690 && p.y < 530) in_view += 10;
+        }
+        const cv::Mat image = renderer.render(world_from_camera, static_cast<unsigned>(t * 100));
+        const TargetDetection d = detectTarget(image, TargetParams(), camera.fx);
+        if (in_view == 0) {
+          ++negatives;
+          if (d.found) ++false_targets;
+          EXPECT_FALSE(d.found) << target_on << " " << trajectory << " t = " << t;
+        } else if (in_view == 44 && max_x - min_x > 40) {
+          ++positives;
+          if (!d.found) continue;
+          ++found;
+          double w = 0;
+          for (int i = 0; i < 4; ++i) {
+            const cv::Point2d truth =
+                camera.project(world_from_camera.inverse().apply(scene.target.corners[i]));
+            w = std::max(w, cv::norm(cv::Point2d(d.corners[i]) - truth));
+          }
+          worst = std::max(worst, w);
+          sum += w;
+          EXPECT_LT(w, 1.0) << target_on << " " << trajectory << " t = " << t;
+        }
+      }
+    }
+  }
+  std::printf("rendered: %d false targets in %d views without the sheet; found %d of %d "
+              "views with it, worst corner %.2f px (mean of worst %.2f)\n",
+              false_targets, negatives, found, positives, worst, sum / std::max(1, found));
+  EXPECT_EQ(false_targets, 0);
+  EXPECT_GE(negatives, 100);
+  EXPECT_GE(positives, 40);
+  EXPECT_GE(found, positives * 95 / 100);
+}
+
+TEST(TargetDetector, RectifiedAspectOfAKnownView) {
+  // A 0.297 x 0.210 sheet 1 m away, tilted 50 deg about the horizontal axis: in the image
+  // its aspect is far from 1.41, rectified with the focal length it is 1.41.
+  const CameraModel camera;
+  const double tilt = 50 * CV_PI / 180;
+  const cv::Matx33d R(1, 0, 0, 0, std::cos(tilt), -std::sin(tilt), 0, std::sin(tilt),
+                      std::cos(tilt));
+  std::array<cv::Point2f, 4> quad;
+  const auto map = targetCornersInMap(TargetParams());
+  for (int i = 0; i < 4; ++i) {
+    const cv::Vec3d x = R * cv::Vec3d(map[i].x, map[i].y, 0) + cv::Vec3d(0, 0, 1);
+    quad[i] = camera.project(x);
+  }
+  const auto aspect = rectifiedAspect(quad, {640, 480}, camera.fx);
+  ASSERT_TRUE(aspect);
+  EXPECT_NEAR(*aspect, 0.297 / 0.210, 0.01);
+  const double in_image = cv::norm(quad[1] - quad[0]) / cv::norm(quad[2] - quad[1]);
+  EXPECT_GT(std::abs(in_image - 0.297 / 0.210), 0.3);
+  // With the focal length estimated from the quadrilateral (Zhang & He): possible when
+  // both pairs of sides converge (tilted about two axes), so turn it 30 deg about y too.
+  const double pan = 30 * CV_PI / 180;
+  const cv::Matx33d Ry(std::cos(pan), 0, std::sin(pan), 0, 1, 0, -std::sin(pan), 0, std::cos(pan));
+  for (int i = 0; i < 4; ++i) {
+    const cv::Vec3d x = Ry * R * cv::Vec3d(map[i].x, map[i].y, 0) + cv::Vec3d(0, 0, 1);
+    quad[i] = camera.project(x);
+  }
+  const auto estimated = rectifiedAspect(quad, {640, 480}, 0);
+  ASSERT_TRUE(estimated);
+  EXPECT_NEAR(*estimated, 0.297 / 0.210, 0.02);
+  // A camera whose principal point is far from the image centre (camera_info's cx, cy):
+  // given, the aspect is right; assumed at the centre, it is not.
+  CameraModel off;
+  off.cx = 200;
+  off.cy = 330;
+  for (int i = 0; i < 4; ++i) {
+    const cv::Vec3d x = Ry * R * cv::Vec3d(map[i].x, map[i].y, 0) + cv::Vec3d(0, 0, 1);
+    quad[i] = off.project(x);
+  }
+  const auto with_pp = rectifiedAspect(quad, {640, 480}, off.fx, {off.cx, off.cy});
+  const auto centred = rectifiedAspect(quad, {640, 480}, off.fx);
+  ASSERT_TRUE(with_pp && centred);
+  EXPECT_NEAR(*with_pp, 0.297 / 0.210, 0.01);
+  EXPECT_GT(std::abs(*centred - 0.297 / 0.210), 0.03) << *centred;
+}
+
+TEST(TargetDetector, RejectionsSayWhy) {
+  // A white sheet on light grey: a quadrilateral, refused for its bright surround.
+  cv::Mat light(480, 640, CV_8UC1, cv::Scalar(170));
+  light(cv::Rect(200, 150, 212, 150)).setTo(240);
+  TargetDetection d = detectTarget(light);
+  EXPECT_FALSE(d.found);
+  EXPECT_EQ(d.rejection, TargetRejection::kBrightSurround) << d.reason;
+  EXPECT_NE(d.reason.find("surround"), std::string::npos);
+  EXPECT_GT(d.rejected[static_cast<int>(TargetRejection::kBrightSurround)], 0);
+  // A square: refused for its aspect ratio (seen head-on with the focal length given).
+  cv::Mat square(480, 640, CV_8UC1, cv::Scalar(20));
+  square(cv::Rect(220, 140, 200, 200)).setTo(230);
+  d = detectTarget(square, TargetParams(), 525);
+  EXPECT_FALSE(d.found);
+  EXPECT_EQ(d.rejection, TargetRejection::kAspect) << d.reason;
+  EXPECT_STREQ(toString(TargetRejection::kAspect), "aspect ratio");
+  // Nothing at all (the image's own frame is the only quadrilateral).
+  d = detectTarget(cv::Mat(480, 640, CV_8UC1, cv::Scalar(90)));
+  EXPECT_FALSE(d.found);
+  EXPECT_NE(d.rejection, TargetRejection::kNone);
+  EXPECT_FALSE(d.reason.empty());
+  d = detectTarget(cv::Mat());
+  EXPECT_EQ(d.rejection, TargetRejection::kBadImage);
 }

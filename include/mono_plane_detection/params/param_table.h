@@ -133,6 +133,7 @@ struct TrackerNodeParams {
   bool lazy = true;
   bool detect_target = true;
   double max_gap_s = 1.0;
+  double target_timeout_s = 30.0;  // WARN when images come this long without a target
   std::string image_transport = "raw";
   double expected_min_rate_hz = 5.0;
   double expected_max_rate_hz = 100.0;

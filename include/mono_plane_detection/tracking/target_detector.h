@@ -1,6 +1,8 @@
-// Start-up (paper II-A): the white rectangle on a black background of known size is
-// found in the image, its four corners refined to sub-pixel, and they give the camera's
-// pose in metres in the map frame (the target's frame). ROS-free.
+// Start-up (paper II-A): the white sheet of known size on a darker surface is found in
+// the image, its four corners refined to sub-pixel, and they give the camera's pose in
+// metres in the map frame (the target's frame, docs/start_up.md). Built for real photos:
+// the background is not black, light is uneven, the paper not flat, the view oblique.
+// ROS-free.
 #pragma once
 
 #include <array>
@@ -13,32 +15,86 @@
 namespace mono_plane_detection {
 
 struct TargetParams {
-  double width_m = 0.297;  // white rectangle, the longer side
+  std::string target_type = "sheet";  // sheet | aruco (tracking/marker_target.h)
+  double width_m = 0.297;             // the sheet, the longer side
   double height_m = 0.210;
   double min_area_px = 400;  // smaller candidates are ignored
-  double max_aspect_distortion =
-      2.5;                      // image long/short side may differ from width/height by this factor
-  double min_contrast = 120;    // grey levels between the white inside and the dark ring
-  double min_structure = 0.95;  // share of the inside above / the ring below Otsu's level
-  double max_ring_ratio = 0.3;  // the black border's mean over the white inside's mean
+  // Surround over sheet brightness just outside / inside its outline (median along it).
+  // Measured on the development photos (test/data/target_photos): dark wood 0.14, brown
+  // wood 0.28-0.31, the half-sunlit table of test2 0.32; light wood (test4) 0.69-0.70,
+  // whose edge with paper is weak under uneven light. 0.45 keeps the first, refuses the
+  // last, with room for a darker or lighter shade of each.
+  double max_surround_ratio = 0.45;
+  // Each side's brightness step, over the image noise's standard deviation (estimated
+  // per image): a real sheet edge is tens of sigmas; texture edges are a few.
+  double min_edge_snr = 8;
+  // The sheet's width/height after rectification by the homography to the known sheet
+  // size, relative error allowed (letter 1.29 vs A4 1.41 differ by 9 %).
+  double max_aspect_error = 0.06;
+  // aruco: dictionary (OpenCV name, e.g. DICT_4X4_50), marker id, black square's side.
+  std::string dictionary = "DICT_4X4_50";
+  int marker_id = 0;
+  double marker_size_m = 0.15;
+  // Start-up: consecutive images in which the target is found with corners that agree
+  // with where the tracker moved them before it fixes the map frame.
+  int confirm_frames = 3;
+  double confirm_tolerance_px = 2.0;  // detected vs tracked corner, largest distance
 };
+
+// Why a candidate (or an image) gave no target; the last stage the best candidate
+// reached. Code, not text, so callers count them.
+enum class TargetRejection {
+  kNone = 0,
+  kBadImage,        // empty, not 8-bit grey, too small
+  kNoCandidate,     // no convex quadrilateral at all
+  kTooSmall,        // under min_area_px or a side under 10 px
+  kAtImageEdge,     // a corner on the image border: cut, or no surround to measure
+  kWeakEdge,        // a side without a clear step over the noise
+  kBrightSurround,  // surround/sheet brightness above max_surround_ratio
+  kAspect,          // rectified width/height not the sheet's
+  kNoMarker,        // aruco: no marker of the dictionary / the id
+  kCount
+};
+const char* toString(TargetRejection r);
 
 struct TargetDetection {
   bool found = false;
   // Ordered as the map frame's corners: (-w/2,-h/2), (+w/2,-h/2), (+w/2,+h/2), (-w/2,+h/2),
   // i.e. for an upright camera bottom-left, bottom-right, top-right, top-left.
   std::array<cv::Point2f, 4> corners;
-  double contrast = 0;  // inside minus ring, grey levels
-  std::string reason;   // why nothing was found
+  double contrast = 0;        // sheet minus surround, grey levels
+  double surround_ratio = 0;  // sheet: surround over sheet brightness (median)
+  TargetRejection rejection = TargetRejection::kNone;
+  std::string reason;  // why nothing was found, with the measured value
+  std::array<int, static_cast<int>(TargetRejection::kCount)> rejected{};  // candidates per reason
 };
 
-// The target in an 8-bit grey image: Otsu threshold, contours, a convex quadrilateral
-// with the target's aspect ratio, white inside and dark around, the most contrasted one;
-// corners refined as intersections of lines fitted to sub-pixel edge points.
-TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params = TargetParams());
+// The sheet in an 8-bit grey image. Candidates: convex quadrilaterals from several
+// global thresholds, an adaptive threshold and the outlines of edges; each must show a
+// step over the noise on all four sides, a dark surround, and after rectification the
+// sheet's width/height. focal_px: the camera's focal length (0: estimated from the
+// quadrilateral); principal_px: its principal point (negative: the image centre).
+TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params = TargetParams(),
+                             double focal_px = 0, cv::Point2d principal_px = {-1, -1});
 
-// The target's corners in the map frame, in TargetDetection's order.
+// The configured target (params.target_type): the sheet or the ArUco marker.
+TargetDetection detectConfiguredTarget(const cv::Mat& gray, const TargetParams& params,
+                                       double focal_px = 0,
+                                       cv::Point2d principal_px = {-1, -1});
+
+// Width/height of the rectangle whose image is `quad` (in order around it, side 0-1 is a
+// width), from the homography and the focal length (0: estimated). Nothing when the
+// quadrilateral cannot be the image of a rectangle in front of the camera.
+std::optional<double> rectifiedAspect(const std::array<cv::Point2f, 4>& quad, cv::Size image,
+                                      double focal_px = 0,
+                                      cv::Point2d principal_px = {-1, -1});
+
+// The target's corners in the map frame, in TargetDetection's order (sheet: width x
+// height; aruco: the marker's square).
 std::array<cv::Point3d, 4> targetCornersInMap(const TargetParams& params);
+
+// Empty when target_type / dictionary are known, else the reason.
+std::string targetParamsError(const TargetParams& params);
 
 struct TargetPose {
   Pose map_from_camera;              // the camera's pose in the map frame

@@ -1,6 +1,10 @@
-// Paper II-A on the image side: until the start-up target has been found, each image is
-// searched for it; its four corners then join the tracker as points flagged as target
-// corners (in TargetDetection's order), so the plane stage can place the camera. ROS-free.
+// Paper II-A on the image side: until the start-up target has been confirmed, each image
+// is searched for it (the sheet or the ArUco marker, params.target_type); its four corners
+// then join the tracker as points flagged as target corners (in TargetDetection's order),
+// so the plane stage can place the camera. One detection is not enough: a target fixes
+// the map frame only after params.confirm_frames consecutive images in which it is found
+// where Lucas-Kanade moved its corners from the image before (a chance quadrilateral in
+// texture does not stay put under the camera's motion). ROS-free.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -16,16 +20,25 @@ class TargetStartup {
   explicit TargetStartup(const TargetParams& params = TargetParams()) : params_(params) {}
 
   // Call after tracker.process(gray). Returns the detection on the image where the target
-  // is found (once); nothing before and after.
-  std::optional<TargetDetection> process(const cv::Mat& gray, FeatureTracker& tracker);
+  // is confirmed (once); nothing before and after. focal_px: 0 when unknown;
+  // principal_px: negative for the image centre.
+  std::optional<TargetDetection> process(const cv::Mat& gray, FeatureTracker& tracker,
+                                         double focal_px = 0,
+                                         cv::Point2d principal_px = {-1, -1});
 
   bool found() const { return found_; }
-  void reset() { found_ = false; }  // search again (the tracker was reset)
+  void reset();  // search again (the tracker was reset)
   const TargetParams& params() const { return params_; }
+  // The last image's detection (found or why not), for diagnostics.
+  const TargetDetection& lastDetection() const { return last_; }
+  int consecutive() const { return consecutive_; }  // images the candidate has been confirmed in
 
  private:
   TargetParams params_;
   bool found_ = false;
+  int consecutive_ = 0;
+  cv::Mat previous_;  // the image of the last detection, for Lucas-Kanade
+  TargetDetection last_;
 };
 
 }  // namespace mono_plane_detection
