@@ -95,9 +95,10 @@ class FeatureTracker {
  public:
   explicit FeatureTracker(const TrackerParams& params = TrackerParams());
 
-  // Processes the next image (CV_8UC1, imageSizeError empty; throws
-  // std::invalid_argument otherwise) and returns the new current state. An image of another size than the
-  // previous one starts over (reset).
+  // Processes the next image and returns the new current state. Throws
+  // std::invalid_argument (with the reason) unless the image is CV_8UC1 and
+  // imageSizeError is empty for it. An image of another size than the previous one
+  // starts over (reset).
   const std::vector<TrackedPoint>& process(const cv::Mat& gray);
 
   // Adds points found by other means on the image just processed (the start-up target's
