@@ -8,6 +8,7 @@
 // video a tracker can follow with truth; the known motion of a real picture gives real
 // texture, real noise and blur, and exact ground truth for every point.
 #include <malloc.h>
+#include <time.h>
 
 #include <algorithm>
 #include <atomic>
@@ -82,8 +83,12 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+// CPU time of this thread: the machine is shared, and time spent waiting for a core is
+// not the tracker's cost (wall time is printed too, for the record).
+double threadMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
 const int kSteadyFrom = 20;  // images before this one are the start-up, not the steady state
@@ -121,19 +126,49 @@ Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int c
 }
 
 struct Timing {
-  double mean = 0, p95 = 0, max = 0;
-  double allocations = 0, kbytes = 0;  // per image, steady state
+  double mean = 0, p95 = 0, max = 0, wall_mean = 0;
+  // Steady state (from image kSteadyFrom on): heap allocations and kB per image, on
+  // images without and with a corner search.
+  double allocations = 0, kbytes = 0, search_allocations = 0, search_kbytes = 0;
 };
 
-Timing timing(const std::vector<double>& ms, long allocations, long bytes, int steady_images) {
-  Timing t;
-  for (double x : ms) t.mean += x / ms.size();
-  t.p95 = percentile(ms, 0.95);
-  t.max = *std::max_element(ms.begin(), ms.end());
-  t.allocations = static_cast<double>(allocations) / std::max(1, steady_images);
-  t.kbytes = static_cast<double>(bytes) / 1024.0 / std::max(1, steady_images);
-  return t;
-}
+// Per-image records of one tracker.
+struct Record {
+  std::vector<double> ms, wall_ms;
+  long allocations[2] = {0, 0}, bytes[2] = {0, 0};  // [searched]
+  int images[2] = {0, 0};
+
+  template <class F>
+  void measure(size_t k, F&& work) {
+    const bool steady = static_cast<int>(k) >= kSteadyFrom;
+    g_allocations = 0;
+    g_bytes = 0;
+    g_counting = steady;
+    const double cpu = threadMs();
+    const auto wall = Clock::now();
+    const bool searched = work();
+    wall_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - wall).count());
+    ms.push_back(threadMs() - cpu);
+    g_counting = false;
+    if (!steady) return;
+    allocations[searched] += g_allocations;
+    bytes[searched] += g_bytes;
+    ++images[searched];
+  }
+
+  Timing timing() const {
+    Timing t;
+    for (double x : ms) t.mean += x / ms.size();
+    for (double x : wall_ms) t.wall_mean += x / wall_ms.size();
+    t.p95 = percentile(ms, 0.95);
+    t.max = *std::max_element(ms.begin(), ms.end());
+    t.allocations = static_cast<double>(allocations[0]) / std::max(1, images[0]);
+    t.kbytes = bytes[0] / 1024.0 / std::max(1, images[0]);
+    t.search_allocations = static_cast<double>(allocations[1]) / std::max(1, images[1]);
+    t.search_kbytes = bytes[1] / 1024.0 / std::max(1, images[1]);
+    return t;
+  }
+};
 
 struct Quality {
   double mean_error = 0, p95_error = 0;
@@ -154,34 +189,53 @@ RowResult runRow(const Sequence& seq, int features) {
   params.max_features = features;
   FeatureTracker tracker(params);
   TrackScorer score;
-  std::vector<double> ms;
+  Record ours, floor;
   std::set<std::uint64_t> first;
   double followed = 0, tracked = 0;
   long reidentified = 0, added = 0;
-  g_allocations = 0;
-  g_bytes = 0;
+  // The floor: goodFeaturesToTrack every 10 images (or when fewer than a third are
+  // left), calcOpticalFlowPyrLK from the previous image on the others; the tracker's
+  // pyramid, window and corner settings; no ids, no checks, no matching.
+  std::vector<cv::Point2f> points, next;
+  std::vector<uchar> status;
+  std::vector<float> error;
+  // Both on each image in turn, so that a busy machine slows both alike.
   for (size_t k = 0; k < seq.images.size(); ++k) {
-    g_counting = static_cast<int>(k) >= kSteadyFrom;
-    const auto start = Clock::now();
-    const auto& points = tracker.process(seq.images[k]);
-    ms.push_back(msSince(start));
-    g_counting = false;
-    score.observe(points, seq.truth[k]);
+    const std::vector<TrackedPoint>* state = nullptr;
+    ours.measure(k, [&] {
+      state = &tracker.process(seq.images[k]);
+      return tracker.lastStats().searched;
+    });
+    floor.measure(k, [&] {
+      if (k % 10 == 0 || points.size() < static_cast<size_t>(features) / 3) {
+        cv::goodFeaturesToTrack(seq.images[k], points, features, params.quality_level,
+                                params.min_distance_px, cv::noArray(), params.block_size);
+        return true;
+      }
+      cv::calcOpticalFlowPyrLK(seq.images[k - 1], seq.images[k], points, next, status, error,
+                               cv::Size(params.window_size_px, params.window_size_px),
+                               params.pyramid_levels - 1);
+      points.clear();
+      for (size_t i = 0; i < next.size(); ++i)
+        if (status[i]) points.push_back(next[i]);
+      return false;
+    });
+    score.observe(*state, seq.truth[k]);
     followed += tracker.previous().size();
     tracked += tracker.lastStats().tracked;
     r.quality.searches += tracker.lastStats().searched;
     if (k == 0) {
-      for (const auto& p : points) first.insert(p.id);
+      for (const auto& p : *state) first.insert(p.id);
     } else {
       reidentified += tracker.lastStats().reidentified;
       added += tracker.lastStats().added;
     }
-    if (k == 99 || (k + 1 == seq.images.size() && k < 99)) {
-      for (const auto& p : points) r.quality.ids_kept += static_cast<int>(first.count(p.id));
+    if (k == 99) {
+      for (const auto& p : *state) r.quality.ids_kept += static_cast<int>(first.count(p.id));
     }
   }
-  const int steady = std::max(0, static_cast<int>(seq.images.size()) - kSteadyFrom);
-  r.ours = timing(ms, g_allocations, g_bytes, steady);
+  r.ours = ours.timing();
+  r.floor = floor.timing();
   r.quality.mean_error = score.meanError();
   r.quality.p95_error = percentile(score.errors(), 0.95);
   r.quality.kept_per_image = followed > 0 ? tracked / followed : 0;
@@ -189,34 +243,6 @@ RowResult runRow(const Sequence& seq, int features) {
   r.quality.reid_rate = reidentified + added > 0
                             ? static_cast<double>(reidentified) / (reidentified + added)
                             : 0;
-
-  // The floor: goodFeaturesToTrack every 10 images (or when fewer than a third are
-  // left), calcOpticalFlowPyrLK from the previous image on the others; the tracker's
-  // pyramid, window and corner settings; no ids, no checks, no matching.
-  ms.clear();
-  g_allocations = 0;
-  g_bytes = 0;
-  std::vector<cv::Point2f> points, next;
-  std::vector<uchar> status;
-  std::vector<float> error;
-  for (size_t k = 0; k < seq.images.size(); ++k) {
-    g_counting = static_cast<int>(k) >= kSteadyFrom;
-    const auto start = Clock::now();
-    if (k % 10 == 0 || points.size() < static_cast<size_t>(features) / 3) {
-      cv::goodFeaturesToTrack(seq.images[k], points, features, params.quality_level,
-                              params.min_distance_px, cv::noArray(), params.block_size);
-    } else {
-      cv::calcOpticalFlowPyrLK(seq.images[k - 1], seq.images[k], points, next, status, error,
-                               cv::Size(params.window_size_px, params.window_size_px),
-                               params.pyramid_levels - 1);
-      points.clear();
-      for (size_t i = 0; i < next.size(); ++i)
-        if (status[i]) points.push_back(next[i]);
-    }
-    ms.push_back(msSince(start));
-    g_counting = false;
-  }
-  r.floor = timing(ms, g_allocations, g_bytes, steady);
   return r;
 }
 
@@ -309,15 +335,18 @@ int main(int argc, char** argv) {
   std::printf(
       "benchmark_tracker_floor: one thread, %d images per row (swing left-right and bob,\n"
       "up to ~8 px per image, sensor noise 3 grey levels), tracker defaults but max_features.\n"
-      "floor = goodFeaturesToTrack every 10 images (or < 1/3 left) + calcOpticalFlowPyrLK.\n"
-      "ms per image mean / p95 / max; alloc = heap allocations per image from image %d on\n"
-      "(whole process, OpenCV included) and their kB; err = px from the truth;\n"
-      "kept = share followed image to image; ids100 = ids of image 0 still there at image 99;\n"
-      "reid = share of new corners that got a lost id back.\n\n",
+      "floor = goodFeaturesToTrack every 10 images (or < 1/3 left) + calcOpticalFlowPyrLK,\n"
+      "run on each image right after ours. ms = CPU ms of the thread per image (mean / p95 /\n"
+      "max; wall = wall-clock mean, the machine is shared); alloc = heap allocations per\n"
+      "image from image %d on (whole process, OpenCV included), images without / with a\n"
+      "search, and kB; err = px from the truth; kept = share followed image to image;\n"
+      "ids100 = ids of image 0 still there at image 99; reid = share of new corners that\n"
+      "got a lost id back; srch = images with a search.\n\n",
       count, kSteadyFrom);
-  std::printf("%-10s %-8s %5s | %22s %11s | %22s %11s | %6s %6s | %6s %6s %6s %7s %5s %4s\n",
-              "source", "image", "feat", "ours mean/p95/max", "alloc kB", "floor mean/p95/max",
-              "alloc kB", "ratio", "p95/m", "err", "p95err", "kept", "ids100", "reid", "srch");
+  std::printf("%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s\n",
+              "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
+              "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e",
+              "kept", "ids100", "reid", "srch");
   std::vector<Row> rows;
   for (const auto& [name, texture] : sources) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
@@ -325,12 +354,16 @@ int main(int argc, char** argv) {
       for (int features : {50, 150, 500}) {
         Row row{name, size, features, runRow(seq, features)};
         const RowResult& r = row.result;
+        auto alloc = [](const Timing& t) {
+          return cv::format("%3.0f/%3.0f %4.0f/%4.0f", t.allocations, t.search_allocations,
+                            t.kbytes, t.search_kbytes);
+        };
         std::printf(
-            "%-10s %4dx%-3d %5d | %6.2f / %6.2f / %6.2f %5.0f %5.0f | %6.2f / %6.2f / %6.2f %5.0f "
-            "%5.0f | %5.2fx %5.2fx | %6.3f %6.3f %5.1f%% %3d/%-3d %4.1f%% %4d\n",
+            "%-9s %3dx%-3d %4d | %5.2f / %5.2f / %5.2f %5.2f %19s | %5.2f / %5.2f / %5.2f %5.2f "
+            "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d\n",
             name.c_str(), size.width, size.height, features, r.ours.mean, r.ours.p95, r.ours.max,
-            r.ours.allocations, r.ours.kbytes, r.floor.mean, r.floor.p95, r.floor.max,
-            r.floor.allocations, r.floor.kbytes, r.ours.mean / r.floor.mean,
+            r.ours.wall_mean, alloc(r.ours).c_str(), r.floor.mean, r.floor.p95, r.floor.max,
+            r.floor.wall_mean, alloc(r.floor).c_str(), r.ours.mean / r.floor.mean,
             r.ours.p95 / r.ours.mean, r.quality.mean_error, r.quality.p95_error,
             100 * r.quality.kept_per_image, r.quality.ids_kept, r.quality.ids_first,
             100 * r.quality.reid_rate, r.quality.searches);
