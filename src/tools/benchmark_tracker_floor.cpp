@@ -181,6 +181,7 @@ struct Quality {
 struct RowResult {
   Timing ours, floor;
   Quality quality;
+  double ratio = 0;  // ours / floor mean time
 };
 
 RowResult runRow(const Sequence& seq, int features) {
@@ -236,6 +237,7 @@ RowResult runRow(const Sequence& seq, int features) {
   }
   r.ours = ours.timing();
   r.floor = floor.timing();
+  r.ratio = r.ours.mean / r.floor.mean;
   r.quality.mean_error = score.meanError();
   r.quality.p95_error = percentile(score.errors(), 0.95);
   r.quality.kept_per_image = followed > 0 ? tracked / followed : 0;
@@ -244,6 +246,30 @@ RowResult runRow(const Sequence& seq, int features) {
                             ? static_cast<double>(reidentified) / (reidentified + added)
                             : 0;
   return r;
+}
+
+// The median of `repeats` runs of a row, figure by figure (the machine is shared: one
+// run can be slowed by others).
+RowResult medianRow(const Sequence& seq, int features, int repeats) {
+  std::vector<RowResult> runs;
+  for (int r = 0; r < repeats; ++r) runs.push_back(runRow(seq, features));
+  auto median = [&](auto get) {
+    std::vector<double> v;
+    for (const auto& r : runs) v.push_back(get(r));
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  RowResult m = runs.front();  // quality and allocations are the same in every run
+  m.ours.mean = median([](const RowResult& r) { return r.ours.mean; });
+  m.ours.p95 = median([](const RowResult& r) { return r.ours.p95; });
+  m.ours.max = median([](const RowResult& r) { return r.ours.max; });
+  m.ours.wall_mean = median([](const RowResult& r) { return r.ours.wall_mean; });
+  m.floor.mean = median([](const RowResult& r) { return r.floor.mean; });
+  m.floor.p95 = median([](const RowResult& r) { return r.floor.p95; });
+  m.floor.max = median([](const RowResult& r) { return r.floor.max; });
+  m.floor.wall_mean = median([](const RowResult& r) { return r.floor.wall_mean; });
+  m.ratio = median([](const RowResult& r) { return r.ours.mean / r.floor.mean; });
+  return m;
 }
 
 struct Row {
@@ -309,7 +335,7 @@ void plot(const std::vector<Row>& rows, const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int count = 150;
+  int count = 150, repeats = 3;
   std::string plot_path = "benchmark_tracker_floor.png";
   std::string euroc, tum;
   cli::Parser cli("benchmark_tracker_floor", "[options]",
@@ -317,6 +343,7 @@ int main(int argc, char** argv) {
                   "  calcOpticalFlowPyrLK, on generated texture and on real images moved by\n"
                   "  known homographies: time, allocations, quality. Figures, never pass/fail.");
   cli.integer("frames", &count, 100, 100000, "images per row (at least 100: ids kept over 100)")
+      .integer("repeats", &repeats, 1, 100, "runs per row; figures are their median")
       .text("plot", &plot_path, "where to write the plot", "FILE.png")
       .text("euroc", &euroc, "a EuRoC image (752x480 grey) as real texture", "FILE.png")
       .text("tum", &tum, "a TUM RGB-D image (640x480 colour) as real texture", "FILE.png");
@@ -333,16 +360,17 @@ int main(int argc, char** argv) {
   }
 
   std::printf(
-      "benchmark_tracker_floor: one thread, %d images per row (swing left-right and bob,\n"
+      "benchmark_tracker_floor: one thread, %d images per row, median of %d runs (swing\n"
+      "left-right and bob,\n"
       "up to ~8 px per image, sensor noise 3 grey levels), tracker defaults but max_features.\n"
       "floor = goodFeaturesToTrack every 10 images (or < 1/3 left) + calcOpticalFlowPyrLK,\n"
       "run on each image right after ours. ms = CPU ms of the thread per image (mean / p95 /\n"
       "max; wall = wall-clock mean, the machine is shared); alloc = heap allocations per\n"
-      "image from image %d on (whole process, OpenCV included), images without / with a\n"
-      "search, and kB; err = px from the truth; kept = share followed image to image;\n"
+      "image from image %d on (whole process, OpenCV included), images without / with\n"
+      "a corner search, and kB; err = px from the truth; kept = share followed image to image;\n"
       "ids100 = ids of image 0 still there at image 99; reid = share of new corners that\n"
       "got a lost id back; srch = images with a search.\n\n",
-      count, kSteadyFrom);
+      count, repeats, kSteadyFrom);
   std::printf("%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s\n",
               "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
               "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e",
@@ -352,7 +380,7 @@ int main(int argc, char** argv) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
       const Sequence seq = makeSequence(texture, size, count);
       for (int features : {50, 150, 500}) {
-        Row row{name, size, features, runRow(seq, features)};
+        Row row{name, size, features, medianRow(seq, features, repeats)};
         const RowResult& r = row.result;
         auto alloc = [](const Timing& t) {
           return cv::format("%3.0f/%3.0f %4.0f/%4.0f", t.allocations, t.search_allocations,
@@ -363,7 +391,7 @@ int main(int argc, char** argv) {
             "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d\n",
             name.c_str(), size.width, size.height, features, r.ours.mean, r.ours.p95, r.ours.max,
             r.ours.wall_mean, alloc(r.ours).c_str(), r.floor.mean, r.floor.p95, r.floor.max,
-            r.floor.wall_mean, alloc(r.floor).c_str(), r.ours.mean / r.floor.mean,
+            r.floor.wall_mean, alloc(r.floor).c_str(), r.ratio,
             r.ours.p95 / r.ours.mean, r.quality.mean_error, r.quality.p95_error,
             100 * r.quality.kept_per_image, r.quality.ids_kept, r.quality.ids_first,
             100 * r.quality.reid_rate, r.quality.searches);

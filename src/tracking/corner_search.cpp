@@ -11,16 +11,18 @@ namespace {
 
 // Sub-pixel refinement of new corners (the same criteria as the tracker's re-anchoring).
 const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+const int kMaxSearchLevel = 1;
+const double kMinSpacingOnLevel = 4.0;
 
 }  // namespace
 
 int cornerSearchLevel(const cv::Size& image, int levels_built, const TrackerParams& params) {
   const int side = minimumImageSide(params);
   int level = 0;
-  while (level < std::min(1, levels_built)) {
+  while (level < std::min(kMaxSearchLevel, levels_built)) {
     const int next = level + 1;
     const bool big_enough = (image.width >> next) >= side && (image.height >> next) >= side;
-    if (!big_enough || params.min_distance_px / (1 << next) < 4.0) break;
+    if (!big_enough || params.min_distance_px / (1 << next) < kMinSpacingOnLevel) break;
     level = next;
   }
   return level;
@@ -51,6 +53,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                                             const cv::Mat* derivatives) {
   std::vector<cv::Point2f>& corners = buffers.corners;
   corners.clear();
+  buffers.from_full_resolution = 0;
   if (wanted <= 0) return corners;
   const float scale = static_cast<float>(1 << level);
   const double min_distance = params.min_distance_px / scale;
@@ -105,6 +108,26 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   // Then by the score where the corner really is, as a full-resolution search would.
   if (rank) rankBy(params.block_size, corners.size());
   keepApart(corners, live, params.min_distance_px, wanted);
+  if (rank && static_cast<int>(corners.size()) < wanted) {
+    // The coarse level holds fewer corners than wanted (fine texture fades there): the
+    // rest comes from full resolution, away from the live points and the corners found.
+    // goodFeaturesToTrack's quality_level is relative to the best corner it sees, and
+    // the masks hide the best ones: the bar is set by the best found or live instead,
+    // as a search of the whole image would.
+    double best = 0;
+    for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
+    for (const auto& c : live) best = std::max(best, score(c, params.block_size));
+    std::vector<cv::Point2f>& taken = buffers.taken;
+    taken = live;
+    taken.insert(taken.end(), corners.begin(), corners.end());
+    std::vector<cv::Point2f> found = std::move(corners);
+    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers);
+    const size_t coarse = found.size();
+    for (const auto& c : buffers.corners)
+      if (score(c, params.block_size) >= params.quality_level * best) found.push_back(c);
+    corners = std::move(found);
+    buffers.from_full_resolution = static_cast<int>(corners.size() - coarse);
+  }
   return corners;
 }
 

@@ -50,6 +50,8 @@ void FeatureTracker::reset() {
   image_size_ = cv::Size();
   found_at_last_search_ = 0;
   frames_since_search_ = 0;
+  coarse_came_short_ = false;
+  searches_at_full_ = 0;
 }
 
 int minimumImageSide(const TrackerParams& params) {
@@ -200,7 +202,11 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
                          ? params_.max_features - static_cast<int>(current_.size())
                          : params_.max_features;
   // The pyramid holds each level's image and derivatives in turn (2 entries per level).
-  const int level = cornerSearchLevel(gray.size(), levels_built_, params_);
+  // A coarse level that came up short (the image's corners are fine-grained, or more
+  // are wanted than it holds) costs a second search at full resolution: search there
+  // directly, and try the coarse level again every fourth search.
+  const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
+  const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
   static const std::vector<cv::Point2f> kNone;
   const size_t per_level = pyramid.size() / (levels_built_ + 1);
@@ -210,6 +216,12 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 
   // Matched corners are the same physical point as a live one: the live point keeps
   // its id and its sub-pixel tracked position.
+  if (level > 0) {
+    coarse_came_short_ = search_buffers_.from_full_resolution > 0;
+    searches_at_full_ = 0;
+  } else if (coarse_came_short_) {
+    ++searches_at_full_;
+  }
   const std::vector<int> match = matchCornersToPoints(corners, live, params_.match_radius_px);
   std::vector<TrackedPoint>& fresh = fresh_;
   fresh.clear();
@@ -252,7 +264,9 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 // Lucas-Kanade with a translation-only window follows the centroid of the window's
 // gradients, not the corner itself: under image rotation or scale this drifts a few
 // hundredths of a pixel per image and accumulates. Pulling live points back onto their
-// corner at each search bounds the drift to the images between searches.
+// corner at each search bounds the drift to the images between searches. (Spreading it
+// over the images, a share of the points on each, was measured: errors grew by up to
+// half on real textures and the search image's time hardly changed.)
 void FeatureTracker::reanchor(const cv::Mat& gray) {
   if (current_.empty()) return;
   std::vector<cv::Point2f>& refined = positionsOf(current_, live_uv_);

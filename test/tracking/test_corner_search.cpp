@@ -155,3 +155,55 @@ TEST(CornerSearch, ShiTomasiScoreMatchesOpenCVsMinEigenValue) {
   EXPECT_LT(shiTomasiScore(derivatives, {50, 30}, 3), 1.0);   // flat
   EXPECT_LT(shiTomasiScore(derivatives, {50, 60}, 3), 1e-6 + shiTomasiScore(derivatives, truth.corners[0], 3) / 100);  // edge
 }
+
+namespace {
+
+// Squares on the left half; on the right half a checkerboard of 2 px cells and
+// `contrast` grey levels, which pyrDown averages down to 1/16 of its contrast (1/256 of
+// the corner score): its corners are strong at full resolution only.
+cv::Mat squaresAndFineCheckerboard(int contrast) {
+  cv::Mat image = squares({640, 480}).image;
+  image.colRange(320, 640).setTo(40);
+  for (int y = 40; y < 440; ++y)
+    for (int x = 360; x < 600; ++x)
+      if ((x / 2 + y / 2) % 2) image.at<uchar>(y, x) = static_cast<uchar>(40 + contrast);
+  return image;
+}
+
+}  // namespace
+
+TEST(CornerSearch, FullResolutionFillsWhatTheCoarseLevelLacks) {
+  const cv::Mat image = squaresAndFineCheckerboard(160);
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const auto& corners = findCorners(image, pyramid[2], 1, {}, 400, params, buffers, &pyramid[1]);
+  // The fill's corners come last: all on the checkerboard (the coarse level sees only
+  // its outline's four corners).
+  EXPECT_GT(buffers.from_full_resolution, 100);
+  ASSERT_LE(buffers.from_full_resolution, static_cast<int>(corners.size()));
+  for (size_t i = corners.size() - buffers.from_full_resolution; i < corners.size(); ++i)
+    EXPECT_TRUE(cv::Rect(358, 38, 244, 404).contains(corners[i])) << corners[i];
+  int coarse_on_board = 0;
+  for (size_t i = 0; i < corners.size() - buffers.from_full_resolution; ++i)
+    coarse_on_board += corners[i].x > 340;
+  EXPECT_LE(coarse_on_board, 4);
+  for (size_t i = 0; i < corners.size(); ++i)
+    for (size_t j = i + 1; j < corners.size(); ++j)
+      EXPECT_GE(cv::norm(corners[i] - corners[j]), params.min_distance_px);
+}
+
+TEST(CornerSearch, FillKeepsTheQualityBarOfTheWholeImage) {
+  // A faint checkerboard (2 grey levels) scores far below 1 % of the squares' corners:
+  // a search of the whole image would not take it, nor does the fill.
+  const cv::Mat image = squaresAndFineCheckerboard(2);
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const auto& corners = findCorners(image, pyramid[2], 1, {}, 400, params, buffers, &pyramid[1]);
+  ASSERT_FALSE(corners.empty());
+  for (const auto& c : corners) EXPECT_LT(c.x, 340) << c;
+  EXPECT_EQ(buffers.from_full_resolution, 0);
+}

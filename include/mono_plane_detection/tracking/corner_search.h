@@ -29,6 +29,8 @@ struct CornerSearchBuffers {
   cv::Mat mask;
   std::vector<cv::Point2f> corners;
   std::vector<std::pair<double, cv::Point2f>> scored;
+  std::vector<cv::Point2f> taken;
+  int from_full_resolution = 0;  // of the last search's corners, found by the fill
 };
 
 // Shi-Tomasi's corner score (the smaller eigenvalue of the gradient matrix summed over a
@@ -40,8 +42,9 @@ double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int bloc
 // full itself) and refined on `full` with cornerSubPix, strongest first, inside the
 // image, spaced by params.min_distance_px from each other and (when `live` is not empty)
 // from the live points, which also mask the search. At most `wanted`. On a coarse level,
-// twice as many candidates are refined and ranked again by shiTomasiScore on
-// `derivatives` (full resolution's, CV_16SC2) when given.
+// three times as many candidates are ranked again by shiTomasiScore on `derivatives`
+// (full resolution's, CV_16SC2) when given, and the best refined. When the coarse level
+// holds fewer than `wanted`, full resolution gives the rest.
 const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,

@@ -159,6 +159,8 @@ class FeatureTracker {
   long frame_count_ = 0;
   int found_at_last_search_ = 0;
   int frames_since_search_ = 0;
+  bool coarse_came_short_ = false;  // the last coarse search needed full resolution too
+  int searches_at_full_ = 0;        // searches since, at full resolution
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
   std::vector<LostPoint> lost_;                             // re-identification pool
 };
