@@ -185,11 +185,10 @@ void FeatureTracker::moveLostWithImage() {
     motion_x_.push_back(d.x);
     motion_y_.push_back(d.y);
   }
-  auto middle = [](std::vector<float>& v) {  // the median, in place (no copy)
+  auto middle = [](std::vector<float>& v) {  // median() of stats.h, in place (no copy)
     const auto mid = v.begin() + v.size() / 2;
     std::nth_element(v.begin(), mid, v.end());
-    if (v.size() % 2) return *mid;
-    return 0.5f * (*mid + *std::max_element(v.begin(), mid));
+    return *mid;
   };
   const cv::Point2f motion(middle(motion_x_), middle(motion_y_));
   for (auto& l : lost_) l.uv += motion;
@@ -201,7 +200,6 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   const int wanted = params_.mask_existing
                          ? params_.max_features - static_cast<int>(current_.size())
                          : params_.max_features;
-  // The pyramid holds each level's image and derivatives in turn (2 entries per level).
   // A coarse level that came up short (the image's corners are fine-grained, or more
   // are wanted than it holds) costs a second search at full resolution: search there
   // directly, and try the coarse level again every fourth search.
@@ -209,6 +207,7 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
   static const std::vector<cv::Point2f> kNone;
+  // The pyramid holds each level's image and derivatives in turn (2 entries per level).
   const size_t per_level = pyramid.size() / (levels_built_ + 1);
   const std::vector<cv::Point2f>& corners =
       findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
