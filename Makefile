@@ -88,8 +88,10 @@ test: build
 
 # The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
 # through the nodelet manager. BENCH_ALL=1 adds the tracker's per-switch tables.
+# BENCH_DATA: the folder with euroc_stereo/ and tum_office_frames/ (real frames).
+BENCH_DATA ?= $(REPO)/../shared/data
 bench: build
-	@source $(DEVEL) && scripts/benchmark.sh $(RESULTS)
+	@source $(DEVEL) && scripts/benchmark.sh $(RESULTS) $(BENCH_DATA)
 	@[ "$(BENCH_ALL)" != 1 ] || { source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker; }
 
 eval: build

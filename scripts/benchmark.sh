@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # make bench: the benchmark suite (tracker and plane stage against baselines, table and
-# plot) and the end-to-end latency through the nodelet manager. Figures, never pass/fail.
-#   scripts/benchmark.sh RESULTS   (the workspace sourced)
+# plot), the tracker against the floor on generated and real frames (table and plot),
+# and the end-to-end latency and resident memory of the nodelet manager (table and
+# plot). Figures, never pass/fail.
+#   scripts/benchmark.sh RESULTS [DATA]   (the workspace sourced; DATA: the folder with
+#   euroc_stereo/ and tum_office_frames/, default ../shared/data next to the repository)
 set -euo pipefail
 results=$1
+data=${2:-$(cd "$(dirname "$0")/.." && pwd)/../shared/data}
 mkdir -p "$results"
 # Both allocator settings: glibc's defaults, and the ones plane_detection.launch sets.
 echo "== glibc malloc defaults"
@@ -12,6 +16,16 @@ echo
 echo "== MALLOC_MMAP_THRESHOLD_=64 MiB, MALLOC_TRIM_THRESHOLD_=256 MiB (as plane_detection.launch)"
 MALLOC_MMAP_THRESHOLD_=67108864 MALLOC_TRIM_THRESHOLD_=268435456 \
   rosrun mono_plane_detection benchmark_suite --plot "$results/benchmark.png"
+echo
+# Real textures: the first EuRoC left image and the first TUM office frame, when there.
+real=()
+euroc=$(ls "$data"/euroc_stereo/cam0/*.png 2>/dev/null | head -1 || true)
+tum=$(ls "$data"/tum_office_frames/*.png 2>/dev/null | head -1 || true)
+[ -n "$euroc" ] && real+=(--euroc "$euroc") || echo "(no EuRoC images under $data/euroc_stereo: generated rows only)"
+[ -n "$tum" ] && real+=(--tum "$tum") || echo "(no TUM frames under $data/tum_office_frames: generated rows only)"
+echo "== tracker against the floor (glibc malloc defaults)"
+rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
+  --plot "$results/benchmark_tracker_floor.png"
 echo
 bag=$results/latency_sequence.bag
 [ -f "$bag" ] || rosrun mono_plane_detection make_sequence --trajectory wheeled --frames 300 \
@@ -22,4 +36,14 @@ roslaunch -p "$port" mono_plane_detection plane_detection.launch profile:=wheele
   > "$results/latency_pipeline.log" 2>&1 &
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
-rosrun mono_plane_detection benchmark_latency --bag "$bag" --rate 30
+# The manager's process id, for its resident memory: roslaunch names it when it starts.
+pid=0
+for _ in $(seq 60); do
+  pid=$(sed -n 's/.*process\[plane_detection_manager-[0-9]*\]: started with pid \[\([0-9]*\)\].*/\1/p' \
+    "$results/latency_pipeline.log" | head -1)
+  [ -n "$pid" ] && break
+  pid=0
+  sleep 0.5
+done
+rosrun mono_plane_detection benchmark_latency --bag "$bag" --rate 30 --pid "$pid" \
+  --plot "$results/benchmark_latency.png"

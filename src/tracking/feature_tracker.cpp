@@ -19,13 +19,6 @@ bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
 }
 
-std::vector<cv::Point2f> positions(const std::vector<TrackedPoint>& points) {
-  std::vector<cv::Point2f> uv;
-  uv.reserve(points.size());
-  for (const auto& p : points) uv.push_back(p.uv);
-  return uv;
-}
-
 // ORB descriptors at given positions; a point too close to the border for ORB's patch
 // gets an empty descriptor.
 std::vector<cv::Mat> orbDescriptors(const cv::Mat& gray, const std::vector<cv::Point2f>& uv) {
@@ -50,13 +43,15 @@ FeatureTracker::FeatureTracker(const TrackerParams& params) : params_(params) {}
 void FeatureTracker::reset() {
   previous_.clear();
   current_.clear();
-  previous_pyramid_.clear();
+  has_previous_pyramid_ = false;  // (the buffers stay for their memory)
   descriptors_.clear();
   lost_.clear();
   stats_ = TrackerFrameStats();
   image_size_ = cv::Size();
   found_at_last_search_ = 0;
   frames_since_search_ = 0;
+  coarse_came_short_ = false;
+  searches_at_full_ = 0;
 }
 
 int minimumImageSide(const TrackerParams& params) {
@@ -84,23 +79,33 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   stats_ = TrackerFrameStats();
 
   const cv::Size window(params_.window_size_px, params_.window_size_px);
-  std::vector<cv::Mat> pyramid;
-  cv::buildOpticalFlowPyramid(gray, pyramid, window, std::max(0, params_.pyramid_levels - 1));
+  // Built into the buffer of the image before last: same sizes, so no new memory.
+  std::vector<cv::Mat>& pyramid = pyramids_[pyramid_now_];
+  levels_built_ = cv::buildOpticalFlowPyramid(gray, pyramid, window,
+                                              std::max(0, params_.pyramid_levels - 1));
 
-  previous_ = std::move(current_);
+  std::swap(previous_, current_);  // (swap, not move: both keep their capacity)
   current_.clear();
-  trackFromPrevious(pyramid, gray.size());
+  if (has_previous_pyramid_) trackFromPrevious(pyramids_[1 - pyramid_now_], pyramid, gray.size());
   ++frames_since_search_;
 
   // Paper II-D: the search runs on this image, before the next one is loaded, so the
   // points still tracked here continue into the new set.
   if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()), frames_since_search_,
                    params_)) {
-    search(gray);
+    search(gray, pyramid);
   }
-  previous_pyramid_ = std::move(pyramid);
+  has_previous_pyramid_ = true;
+  pyramid_now_ = 1 - pyramid_now_;
   ++frame_count_;
   return current_;
+}
+
+std::vector<cv::Point2f>& FeatureTracker::positionsOf(const std::vector<TrackedPoint>& points,
+                                                      std::vector<cv::Point2f>& out) const {
+  out.clear();
+  for (const auto& p : points) out.push_back(p.uv);
+  return out;
 }
 
 std::vector<std::uint64_t> FeatureTracker::addPoints(const std::vector<cv::Point2f>& uv,
@@ -120,24 +125,24 @@ std::vector<std::uint64_t> FeatureTracker::addPoints(const std::vector<cv::Point
   return ids;
 }
 
-void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
-  if (previous_.empty() || previous_pyramid_.empty()) return;
+void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
+                                       const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
+  if (previous_.empty()) return;
   const cv::Size window(params_.window_size_px, params_.window_size_px);
   const int max_level = std::max(0, params_.pyramid_levels - 1);
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                   params_.max_iterations, params_.epsilon_px);
-  const std::vector<cv::Point2f> before = positions(previous_);
-  std::vector<cv::Point2f> after;
-  std::vector<uchar> status;
-  std::vector<float> error;
-  cv::calcOpticalFlowPyrLK(previous_pyramid_, pyramid, before, after, status, error, window,
+  const std::vector<cv::Point2f>& before = positionsOf(previous_, before_);
+  std::vector<cv::Point2f>& after = after_;
+  std::vector<uchar>& status = status_;
+  cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after, status, error_, window,
                            max_level, criteria, 0, params_.min_eigen_threshold);
 
-  std::vector<uchar> back_status(before.size(), 1);
-  std::vector<cv::Point2f> back;
+  std::vector<uchar>& back_status = back_status_;
+  std::vector<cv::Point2f>& back = back_;
   if (params_.forward_backward_check) {
     back = after;
-    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid_, after, back, back_status, error, window,
+    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back, back_status, error_, window,
                              max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
                              params_.min_eigen_threshold);
     back_status.resize(before.size(), 0);
@@ -173,61 +178,76 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& pyramid, cons
 // rotation, the paper's case of points leaving and coming back).
 void FeatureTracker::moveLostWithImage() {
   if (lost_.empty() || current_.empty()) return;
-  std::vector<float> dx, dy;
+  motion_x_.clear();
+  motion_y_.clear();
   for (const auto& p : current_) {
     const cv::Point2f d = p.uv - previous_[p.prev_index].uv;
-    dx.push_back(d.x);
-    dy.push_back(d.y);
+    motion_x_.push_back(d.x);
+    motion_y_.push_back(d.y);
   }
-  const cv::Point2f motion(median(std::move(dx)), median(std::move(dy)));
+  auto middle = [](std::vector<float>& v) {  // median() of stats.h, in place (no copy)
+    const auto mid = v.begin() + v.size() / 2;
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  const cv::Point2f motion(middle(motion_x_), middle(motion_y_));
   for (auto& l : lost_) l.uv += motion;
 }
 
-cv::Mat FeatureTracker::searchMask(const cv::Size& size) const {
-  cv::Mat mask(size, CV_8UC1, cv::Scalar(255));
-  const int radius = static_cast<int>(std::ceil(params_.min_distance_px));
-  for (const auto& p : current_) cv::circle(mask, p.uv, radius, cv::Scalar(0), cv::FILLED);
-  return mask;
-}
-
-void FeatureTracker::search(const cv::Mat& gray) {
+void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid) {
   stats_.searched = true;
   if (params_.reanchor_on_search) reanchor(gray);
-  std::vector<cv::Point2f> corners;
   const int wanted = params_.mask_existing
                          ? params_.max_features - static_cast<int>(current_.size())
                          : params_.max_features;
-  if (wanted > 0) {
-    const cv::Mat mask = params_.mask_existing ? searchMask(gray.size()) : cv::Mat();
-    cv::goodFeaturesToTrack(gray, corners, wanted, params_.quality_level, params_.min_distance_px,
-                            mask, params_.block_size);
-  }
-  if (!corners.empty()) {
-    cv::cornerSubPix(gray, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
-    // Refinement can push a border corner just outside the image.
-    corners.erase(std::remove_if(corners.begin(), corners.end(),
-                                 [&](const cv::Point2f& c) { return !inside(c, gray.size()); }),
-                  corners.end());
-  }
+  // A coarse level that came up short (the image's corners are fine-grained, or more
+  // are wanted than it holds) costs a second search at full resolution: search there
+  // directly, and try the coarse level again every fourth search.
+  const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
+  const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
+  const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
+  static const std::vector<cv::Point2f> kNone;
+  // The pyramid holds each level's image and derivatives in turn (2 entries per level).
+  const size_t per_level = pyramid.size() / (levels_built_ + 1);
+  const std::vector<cv::Point2f>& corners =
+      findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
+                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr);
 
   // Matched corners are the same physical point as a live one: the live point keeps
   // its id and its sub-pixel tracked position.
-  const std::vector<int> match =
-      matchCornersToPoints(corners, positions(current_), params_.match_radius_px);
-  std::vector<TrackedPoint> fresh;
+  if (level > 0) {
+    coarse_came_short_ = search_buffers_.from_full_resolution > 0;
+    searches_at_full_ = 0;
+  } else if (coarse_came_short_) {
+    ++searches_at_full_;
+  }
+  const std::vector<int> match = matchCornersToPoints(corners, live, params_.match_radius_px);
+  std::vector<TrackedPoint>& fresh = fresh_;
+  fresh.clear();
   for (size_t c = 0; c < corners.size(); ++c) {
     if (match[c] >= 0) {
       ++stats_.matched;
       continue;
     }
-    if (static_cast<int>(current_.size() + fresh.size()) >= params_.max_features) break;
+    // Full: later corners are still checked, so `matched` counts every re-found point.
+    if (static_cast<int>(current_.size() + fresh.size()) >= params_.max_features) continue;
     TrackedPoint p;
     p.uv = corners[c];
     p.is_new = true;
     fresh.push_back(p);
   }
 
-  if (params_.reidentify) reidentify(gray, fresh);
+  // One ORB call for the live points and the new corners: the new corners' part is
+  // compared with the lost points, and all are remembered for when they get lost.
+  std::vector<cv::Mat> descriptors;
+  if (params_.reidentify) {
+    positionsOf(current_, live_uv_);
+    for (const auto& p : fresh) live_uv_.push_back(p.uv);
+    descriptors = orbDescriptors(gray, live_uv_);
+    const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + current_.size(),
+                                                 descriptors.end());
+    reidentify(fresh_descriptors, fresh);
+  }
   for (auto& p : fresh) {
     if (!p.is_reidentified) {
       p.id = next_id_++;
@@ -235,7 +255,7 @@ void FeatureTracker::search(const cv::Mat& gray) {
     }
     current_.push_back(p);
   }
-  if (params_.reidentify) refreshDescriptors(gray);
+  if (params_.reidentify) refreshDescriptors(descriptors);
   found_at_last_search_ = static_cast<int>(current_.size());
   frames_since_search_ = 0;
 }
@@ -243,10 +263,12 @@ void FeatureTracker::search(const cv::Mat& gray) {
 // Lucas-Kanade with a translation-only window follows the centroid of the window's
 // gradients, not the corner itself: under image rotation or scale this drifts a few
 // hundredths of a pixel per image and accumulates. Pulling live points back onto their
-// corner at each search bounds the drift to the images between searches.
+// corner at each search bounds the drift to the images between searches. (Spreading it
+// over the images, a share of the points on each, was measured: errors grew by up to
+// half on real textures and the search image's time hardly changed.)
 void FeatureTracker::reanchor(const cv::Mat& gray) {
   if (current_.empty()) return;
-  std::vector<cv::Point2f> refined = positions(current_);
+  std::vector<cv::Point2f>& refined = positionsOf(current_, live_uv_);
   const int half = params_.reanchor_window_px;
   cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1), kSubPixCriteria);
   const double max_shift2 = params_.reanchor_max_shift_px * params_.reanchor_max_shift_px;
@@ -264,7 +286,8 @@ void FeatureTracker::rememberLost(const TrackedPoint& point) {
   descriptors_.erase(it);
 }
 
-void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& fresh) {
+void FeatureTracker::reidentify(const std::vector<cv::Mat>& descriptors,
+                                std::vector<TrackedPoint>& fresh) {
   lost_.erase(std::remove_if(lost_.begin(), lost_.end(),
                              [this](const LostPoint& l) {
                                return frame_count_ - l.lost_at_frame > params_.reid_memory_frames;
@@ -272,7 +295,6 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
               lost_.end());
   if (lost_.empty() || fresh.empty()) return;
 
-  const std::vector<cv::Mat> descriptors = orbDescriptors(gray, positions(fresh));
   // Each fresh corner claims its best lost point; paper II-D's rule settles conflicts.
   std::vector<int> claim(fresh.size(), -1);
   std::vector<double> claim_distance(fresh.size(), 0.0);
@@ -320,8 +342,7 @@ void FeatureTracker::reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& 
   lost_ = std::move(kept);
 }
 
-void FeatureTracker::refreshDescriptors(const cv::Mat& gray) {
-  const std::vector<cv::Mat> descriptors = orbDescriptors(gray, positions(current_));
+void FeatureTracker::refreshDescriptors(const std::vector<cv::Mat>& descriptors) {
   descriptors_.clear();
   for (size_t i = 0; i < current_.size(); ++i) {
     if (!descriptors[i].empty()) descriptors_[current_[i].id] = descriptors[i];

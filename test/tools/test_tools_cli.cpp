@@ -21,7 +21,7 @@ const std::vector<std::pair<std::string, std::string>> kTools = {
     {"benchmark_tracker", BENCHMARK_TRACKER_PATH}, {"demo_report", DEMO_REPORT_PATH},
     {"detect_target", DETECT_TARGET_PATH},
     {"make_sequence", MAKE_SEQUENCE_PATH},         {"run_pipeline", RUN_PIPELINE_PATH},
-    {"segment_planes", SEGMENT_PLANES_PATH}};
+    {"segment_planes", SEGMENT_PLANES_PATH},       {"benchmark_tracker_floor", BENCHMARK_TRACKER_FLOOR_PATH}};
 
 // No master on port 1: a program that tried to reach one would wait; `timeout` ends it.
 ProgramRun run(const std::string& path, const std::string& args) {

@@ -241,7 +241,57 @@ TEST(FeatureTracker, RejectsWrongImageTypes) {
   EXPECT_THROW(tracker.process(cv::Mat()), std::invalid_argument);
   EXPECT_THROW(tracker.process(cv::Mat(10, 10, CV_8UC3)), std::invalid_argument);
   EXPECT_THROW(tracker.process(cv::Mat(10, 10, CV_32FC1)), std::invalid_argument);
-  EXPECT_NO_THROW(tracker.process(cv::Mat(1, 1, CV_8UC1, cv::Scalar(0))));
+}
+
+// Images smaller than the tracker's windows are refused with the reason (the sizes),
+// never an OpenCV assert; the smallest accepted size is tracked, whatever the windows.
+TEST(FeatureTracker, RefusesImagesSmallerThanItsWindows) {
+  FeatureTracker tracker;
+  const int side = minimumImageSide(tracker.params());
+  EXPECT_EQ(side, 11);  // cornerSubPix: 2 x 3 + 5
+  try {
+    tracker.process(cv::Mat(1, 1, CV_8UC1, cv::Scalar(0)));
+    ADD_FAILURE() << "a 1x1 image was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("1x1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("11 px"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(tracker.process(cv::Mat(side - 1, 200, CV_8UC1, cv::Scalar(0))),
+               std::invalid_argument);
+  EXPECT_THROW(tracker.process(cv::Mat(200, side - 1, CV_8UC1, cv::Scalar(0))),
+               std::invalid_argument);
+  EXPECT_TRUE(imageSizeError({side, side}, tracker.params()).empty());
+  EXPECT_FALSE(imageSizeError({side - 1, side}, tracker.params()).empty());
+}
+
+TEST(FeatureTracker, SmallestAcceptedImagesAreTrackedWithAnyWindows) {
+  for (int reanchor : {1, 3, 15}) {
+    for (int lk_window : {3, 51}) {
+      for (int block : {1, 31}) {
+        TrackerParams params;
+        params.reanchor_window_px = reanchor;
+        params.window_size_px = lk_window;
+        params.block_size = block;
+        params.pyramid_levels = 10;
+        params.min_distance_px = 0;
+        const int side = minimumImageSide(params);
+        for (const cv::Size size : {cv::Size(side, side), cv::Size(side + 1, side + 3),
+                                    cv::Size(4 * side, side)}) {
+          FeatureTracker tracker(params);
+          const auto hs = translations(12, kCentred, {0.5, 0.3});
+          for (const auto& H : hs) {
+            ASSERT_NO_THROW(tracker.process(warpView(texture(), H, size)))
+                << size << " reanchor " << reanchor << " window " << lk_window << " block "
+                << block;
+            for (const auto& p : tracker.current()) {
+              EXPECT_TRUE(p.uv.x >= 0 && p.uv.y >= 0 && p.uv.x <= size.width - 1 &&
+                          p.uv.y <= size.height - 1);
+            }
+          }
+        }
+      }
+    }
+  }
 }
 
 TEST(FeatureTracker, ResetKeepsIdsIncreasing) {

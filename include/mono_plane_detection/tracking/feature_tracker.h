@@ -10,6 +10,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "mono_plane_detection/tracking/corner_search.h"
+
 namespace mono_plane_detection {
 
 struct TrackerParams {
@@ -95,9 +97,10 @@ class FeatureTracker {
  public:
   explicit FeatureTracker(const TrackerParams& params = TrackerParams());
 
-  // Processes the next image (CV_8UC1, imageSizeError empty; throws
-  // std::invalid_argument otherwise) and returns the new current state. An image of another size than the
-  // previous one starts over (reset).
+  // Processes the next image and returns the new current state. Throws
+  // std::invalid_argument (with the reason) unless the image is CV_8UC1 and
+  // imageSizeError is empty for it. An image of another size than the previous one
+  // starts over (reset).
   const std::vector<TrackedPoint>& process(const cv::Mat& gray);
 
   // Adds points found by other means on the image just processed (the start-up target's
@@ -123,25 +126,41 @@ class FeatureTracker {
     cv::Mat descriptor;
   };
 
-  void trackFromPrevious(const std::vector<cv::Mat>& pyramid, const cv::Size& size);
-  void search(const cv::Mat& gray);
+  void trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
+                         const std::vector<cv::Mat>& pyramid, const cv::Size& size);
+  void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
   void reanchor(const cv::Mat& gray);
-  cv::Mat searchMask(const cv::Size& size) const;
   void moveLostWithImage();
-  void reidentify(const cv::Mat& gray, std::vector<TrackedPoint>& fresh);
+  void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
-  void refreshDescriptors(const cv::Mat& gray);
+  void refreshDescriptors(const std::vector<cv::Mat>& descriptors);
+  std::vector<cv::Point2f>& positionsOf(const std::vector<TrackedPoint>& points,
+                                        std::vector<cv::Point2f>& out) const;
 
   TrackerParams params_;
   std::vector<TrackedPoint> previous_;
   std::vector<TrackedPoint> current_;
   TrackerFrameStats stats_;
-  std::vector<cv::Mat> previous_pyramid_;
+  // One pyramid per image (with its derivatives), shared by Lucas-Kanade forward and
+  // backward and the corner search; two kept buffers take turns so that the steady
+  // state allocates no image memory.
+  std::vector<cv::Mat> pyramids_[2];
+  int pyramid_now_ = 0;
+  bool has_previous_pyramid_ = false;
+  int levels_built_ = 0;
+  // Per-image work buffers, kept for their capacity.
+  std::vector<cv::Point2f> before_, after_, back_, live_uv_, fresh_uv_;
+  std::vector<uchar> status_, back_status_;
+  std::vector<float> error_, motion_x_, motion_y_;
+  std::vector<TrackedPoint> fresh_;
+  CornerSearchBuffers search_buffers_;
   cv::Size image_size_;
   std::uint64_t next_id_ = 1;
   long frame_count_ = 0;
   int found_at_last_search_ = 0;
   int frames_since_search_ = 0;
+  bool coarse_came_short_ = false;  // the last coarse search needed full resolution too
+  int searches_at_full_ = 0;        // searches since, at full resolution
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
   std::vector<LostPoint> lost_;                             // re-identification pool
 };

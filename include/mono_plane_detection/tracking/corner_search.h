@@ -1,0 +1,54 @@
+// The tracker's corner search (paper II-B: Shi-Tomasi, at most max_features corners at
+// least min_distance_px apart) made cheap: it runs on a coarser level of the pyramid the
+// tracker has already built for Lucas-Kanade, and each corner is then refined on the
+// full-resolution image. A quarter of the pixels per level, so the image that searches
+// costs little more than the others. ROS-free.
+#pragma once
+
+#include <utility>
+#include <vector>
+#include <opencv2/core.hpp>
+
+namespace mono_plane_detection {
+
+struct TrackerParams;  // feature_tracker.h
+
+// The pyramid level to search on: the coarsest one at most 1 whose image is at least
+// minimumImageSide per side and where min_distance_px is still >= 4 px (so the spacing
+// rule keeps its meaning), capped by the levels that were built. 0 means full resolution.
+int cornerSearchLevel(const cv::Size& image, int levels_built, const TrackerParams& params);
+
+// Keeps, in order, the corners that are at least min_distance_px from every corner kept
+// before them and from every point of `live`; at most `wanted`. Returns how many were
+// dropped. (The spacing rule at full resolution, after refinement moved the corners.)
+int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
+              double min_distance_px, int wanted);
+
+// Buffers kept across searches so that a search allocates nothing they can hold.
+struct CornerSearchBuffers {
+  cv::Mat mask;
+  std::vector<cv::Point2f> corners;
+  std::vector<std::pair<double, cv::Point2f>> scored;
+  std::vector<cv::Point2f> taken;
+  int from_full_resolution = 0;  // of the last search's corners, found by the fill
+};
+
+// Shi-Tomasi's corner score (the smaller eigenvalue of the gradient matrix summed over a
+// block_size square) at the pixel nearest p, from x and y derivatives (CV_16SC2, as
+// cv::buildOpticalFlowPyramid stores them next to each level); pixels outside are left out.
+double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int block_size);
+
+// Shi-Tomasi corners of `full`, found on `level_image` (level `level` of its pyramid, 0:
+// full itself) and refined on `full` with cornerSubPix, strongest first, inside the
+// image, spaced by params.min_distance_px from each other and (when `live` is not empty)
+// from the live points, which also mask the search. At most `wanted`. On a coarse level,
+// three times as many candidates are ranked again by shiTomasiScore on `derivatives`
+// (full resolution's, CV_16SC2) when given, and the best refined. When the coarse level
+// holds fewer than `wanted`, full resolution gives the rest.
+const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
+                                            int level, const std::vector<cv::Point2f>& live,
+                                            int wanted, const TrackerParams& params,
+                                            CornerSearchBuffers& buffers,
+                                            const cv::Mat* derivatives = nullptr);
+
+}  // namespace mono_plane_detection

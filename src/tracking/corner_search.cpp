@@ -1,0 +1,154 @@
+#include "mono_plane_detection/tracking/corner_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "mono_plane_detection/tracking/feature_tracker.h"
+
+namespace mono_plane_detection {
+namespace {
+
+// Sub-pixel refinement of new corners (the same criteria as the tracker's re-anchoring).
+const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+const int kMaxSearchLevel = 1;
+const double kMinSpacingOnLevel = 4.0;
+
+}  // namespace
+
+int cornerSearchLevel(const cv::Size& image, int levels_built, const TrackerParams& params) {
+  const int side = minimumImageSide(params);
+  int level = 0;
+  while (level < std::min(kMaxSearchLevel, levels_built)) {
+    const int next = level + 1;
+    const bool big_enough = (image.width >> next) >= side && (image.height >> next) >= side;
+    if (!big_enough || params.min_distance_px / (1 << next) < kMinSpacingOnLevel) break;
+    level = next;
+  }
+  return level;
+}
+
+int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
+              double min_distance_px, int wanted) {
+  const double min2 = min_distance_px * min_distance_px;
+  const size_t before = corners.size();
+  size_t kept = 0;
+  for (size_t c = 0; c < corners.size() && static_cast<int>(kept) < wanted; ++c) {
+    auto far = [&](const cv::Point2f& p) {
+      const cv::Point2f d = corners[c] - p;
+      return static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y >= min2;
+    };
+    if (!std::all_of(corners.begin(), corners.begin() + kept, far)) continue;
+    if (!std::all_of(live.begin(), live.end(), far)) continue;
+    corners[kept++] = corners[c];
+  }
+  corners.resize(kept);
+  return static_cast<int>(before - kept);
+}
+
+const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
+                                            int level, const std::vector<cv::Point2f>& live,
+                                            int wanted, const TrackerParams& params,
+                                            CornerSearchBuffers& buffers,
+                                            const cv::Mat* derivatives) {
+  std::vector<cv::Point2f>& corners = buffers.corners;
+  corners.clear();
+  buffers.from_full_resolution = 0;
+  if (wanted <= 0) return corners;
+  const float scale = static_cast<float>(1 << level);
+  const double min_distance = params.min_distance_px / scale;
+  cv::Mat mask;
+  if (!live.empty()) {
+    buffers.mask.create(level_image.size(), CV_8UC1);
+    buffers.mask.setTo(cv::Scalar(255));
+    const int radius = static_cast<int>(std::ceil(min_distance));
+    for (const auto& p : live) cv::circle(buffers.mask, p / scale, radius, cv::Scalar(0), cv::FILLED);
+    mask = buffers.mask;
+  }
+  // On a coarse level, three times as many as wanted: they are ranked again at full
+  // resolution. A coarse level ranks corners by their coarse structure, which changes
+  // more from image to image than the full-resolution score; ranked by the latter, the
+  // search finds the same corners again (paper II-D keeps ids by finding them again).
+  const bool rank = level > 0 && derivatives != nullptr;
+  const int ask = rank ? 3 * wanted + 8 : wanted;
+  cv::goodFeaturesToTrack(level_image, corners, ask, params.quality_level, min_distance, mask,
+                          params.block_size);
+  if (corners.empty()) return corners;
+  for (auto& c : corners) c *= scale;  // pyrDown keeps pixel 2i of the finer level at i
+  // Score: the best of the pixel nearest the corner and its 8 neighbours (a corner found
+  // by goodFeaturesToTrack is its neighbourhood's maximum).
+  auto score = [&](const cv::Point2f& c, int block) {
+    double best = 0;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        best = std::max(best, shiTomasiScore(*derivatives, c + cv::Point2f(dx, dy), block));
+    return best;
+  };
+  auto rankBy = [&](int block, size_t keep) {
+    auto& scored = buffers.scored;
+    scored.clear();
+    for (const auto& c : corners) scored.push_back({-score(c, block), c});
+    std::stable_sort(scored.begin(), scored.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    corners.resize(std::min(corners.size(), keep));
+    for (size_t i = 0; i < corners.size(); ++i) corners[i] = scored[i].second;
+  };
+  // First by a block that covers the coarse position's uncertainty (a coarse pixel each
+  // way), to refine only the likely ones.
+  if (rank) rankBy(params.block_size + 2 * (1 << level), static_cast<size_t>(2 * wanted + 8));
+  // A coarse corner is within a coarse pixel of the true one: the 7x7 window reaches it.
+  cv::cornerSubPix(full, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
+  // Refinement can push a border corner just outside the image.
+  corners.erase(std::remove_if(corners.begin(), corners.end(),
+                               [&](const cv::Point2f& c) {
+                                 return !(c.x >= 0.f && c.y >= 0.f && c.x <= full.cols - 1.f &&
+                                          c.y <= full.rows - 1.f);
+                               }),
+                corners.end());
+  // Then by the score where the corner really is, as a full-resolution search would.
+  if (rank) rankBy(params.block_size, corners.size());
+  keepApart(corners, live, params.min_distance_px, wanted);
+  if (rank && static_cast<int>(corners.size()) < wanted) {
+    // The coarse level holds fewer corners than wanted (fine texture fades there): the
+    // rest comes from full resolution, away from the live points and the corners found.
+    // goodFeaturesToTrack's quality_level is relative to the best corner it sees, and
+    // the masks hide the best ones: the bar is set by the best found or live instead,
+    // as a search of the whole image would.
+    double best = 0;
+    for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
+    for (const auto& c : live) best = std::max(best, score(c, params.block_size));
+    std::vector<cv::Point2f>& taken = buffers.taken;
+    taken = live;
+    taken.insert(taken.end(), corners.begin(), corners.end());
+    std::vector<cv::Point2f> found = std::move(corners);
+    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers);
+    const size_t coarse = found.size();
+    for (const auto& c : buffers.corners)
+      if (score(c, params.block_size) >= params.quality_level * best) found.push_back(c);
+    corners = std::move(found);
+    buffers.from_full_resolution = static_cast<int>(corners.size() - coarse);
+  }
+  return corners;
+}
+
+double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int block_size) {
+  CV_Assert(derivatives.type() == CV_16SC2);
+  const int half = std::max(0, block_size / 2);
+  const int cx = cvRound(p.x), cy = cvRound(p.y);
+  double a = 0, b = 0, c = 0;
+  for (int y = cy - half; y <= cy + half; ++y) {
+    if (y < 0 || y >= derivatives.rows) continue;
+    const cv::Vec2s* row = derivatives.ptr<cv::Vec2s>(y);
+    for (int x = cx - half; x <= cx + half; ++x) {
+      if (x < 0 || x >= derivatives.cols) continue;
+      const double dx = row[x][0], dy = row[x][1];
+      a += dx * dx;
+      b += dx * dy;
+      c += dy * dy;
+    }
+  }
+  // Smaller eigenvalue of [a b; b c].
+  return 0.5 * (a + c) - std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+}
+
+}  // namespace mono_plane_detection

@@ -1,0 +1,209 @@
+// The corner search on a coarser pyramid level against corners whose place is known
+// exactly: the corners of bright squares on a dark background.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "mono_plane_detection/tracking/corner_search.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
+
+using namespace mono_plane_detection;
+
+namespace {
+
+// Squares of 20 px every 50 px from (40, 40); a square filling pixels x0..x0+19 has its
+// corners where its edges meet: (x0 - 0.5, y0 - 0.5), (x0 + 19.5, y0 - 0.5), ...
+struct Squares {
+  cv::Mat image;
+  std::vector<cv::Point2f> corners;
+};
+
+Squares squares(const cv::Size& size) {
+  Squares s;
+  s.image = cv::Mat(size, CV_8UC1, cv::Scalar(40));
+  for (int y0 = 40; y0 + 20 < size.height - 20; y0 += 50) {
+    for (int x0 = 40; x0 + 20 < size.width - 20; x0 += 50) {
+      s.image(cv::Rect(x0, y0, 20, 20)).setTo(200);
+      for (float dx : {-0.5f, 19.5f})
+        for (float dy : {-0.5f, 19.5f}) s.corners.push_back({x0 + dx, y0 + dy});
+    }
+  }
+  cv::GaussianBlur(s.image, s.image, cv::Size(3, 3), 0.8);  // symmetric: corners stay
+  return s;
+}
+
+double nearest(const cv::Point2f& p, const std::vector<cv::Point2f>& truth) {
+  double best = 1e9;
+  for (const auto& t : truth) best = std::min(best, cv::norm(p - t));
+  return best;
+}
+
+std::vector<cv::Mat> pyramidOf(const cv::Mat& image, int* levels) {
+  std::vector<cv::Mat> pyramid;
+  *levels = cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(7, 7), 4);
+  return pyramid;
+}
+
+}  // namespace
+
+TEST(CornerSearch, LevelIsOneWhereTheSpacingAndImageAllowIt) {
+  TrackerParams params;  // min_distance 15 px
+  EXPECT_EQ(cornerSearchLevel({640, 480}, 4, params), 1);
+  EXPECT_EQ(cornerSearchLevel({320, 240}, 4, params), 1);
+  EXPECT_EQ(cornerSearchLevel({640, 480}, 0, params), 0);  // no coarser level built
+  EXPECT_EQ(cornerSearchLevel({21, 480}, 4, params), 0);   // level 1 narrower than 11 px
+  EXPECT_EQ(cornerSearchLevel({22, 22}, 4, params), 1);
+  params.min_distance_px = 7.9;  // 3.95 px on level 1: the spacing would lose its meaning
+  EXPECT_EQ(cornerSearchLevel({640, 480}, 4, params), 0);
+  params.min_distance_px = 100;  // never coarser than level 1
+  EXPECT_EQ(cornerSearchLevel({640, 480}, 4, params), 1);
+}
+
+TEST(CornerSearch, KeepApartKeepsTheFirstOfCloseCorners) {
+  std::vector<cv::Point2f> corners{{0, 0}, {10, 0}, {20, 0}, {5, 5}, {40, 0}, {50, 0}};
+  EXPECT_EQ(keepApart(corners, {}, 15.0, 100), 3);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{0, 0}, {20, 0}, {40, 0}}));
+
+  corners = {{0, 0}, {20, 0}, {40, 0}, {60, 0}};
+  EXPECT_EQ(keepApart(corners, {{41, 3}}, 15.0, 100), 1);  // the live point takes (40, 0)
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{0, 0}, {20, 0}, {60, 0}}));
+
+  corners = {{0, 0}, {20, 0}, {40, 0}, {60, 0}};
+  EXPECT_EQ(keepApart(corners, {}, 15.0, 2), 2);  // at most `wanted`, strongest first
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{0, 0}, {20, 0}}));
+
+  corners = {{0, 0}, {15, 0}};  // exactly min_distance apart is apart
+  EXPECT_EQ(keepApart(corners, {}, 15.0, 10), 0);
+}
+
+// cornerSubPix puts a blurred square's far corners 0.15 px inside (measured alike at
+// either level): 0.25 px is the refinement's own accuracy.
+TEST(CornerSearch, CoarseLevelFindsTheTrueCornersAsWellAsFullResolution) {
+  const Squares truth = squares({640, 480});
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(truth.image, &levels);
+  ASSERT_GE(levels, 1);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const std::vector<cv::Point2f> coarse =
+      findCorners(truth.image, pyramid[2], 1, {}, 50, params, buffers, &pyramid[1]);
+  ASSERT_EQ(coarse.size(), 50u);
+  for (const auto& c : coarse) EXPECT_LT(nearest(c, truth.corners), 0.25) << c;
+  for (size_t i = 0; i < coarse.size(); ++i)
+    for (size_t j = i + 1; j < coarse.size(); ++j)
+      EXPECT_GE(cv::norm(coarse[i] - coarse[j]), params.min_distance_px);
+
+  // Full resolution (level 0) finds corners just as true, the same ones when all are wanted.
+  const std::vector<cv::Point2f> fine =
+      findCorners(truth.image, truth.image, 0, {}, 1000, params, buffers);
+  ASSERT_EQ(fine.size(), truth.corners.size());
+  for (const auto& c : fine) EXPECT_LT(nearest(c, truth.corners), 0.25) << c;
+  // The same refined places either way.
+  for (const auto& c : coarse) EXPECT_LT(nearest(c, fine), 0.01) << c;
+}
+
+TEST(CornerSearch, LivePointsMaskTheSearch) {
+  const Squares truth = squares({320, 240});
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(truth.image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  // Live points on every corner of the top row of squares.
+  std::vector<cv::Point2f> live;
+  for (const auto& c : truth.corners)
+    if (c.y < 40) live.push_back(c);
+  ASSERT_GT(live.size(), 4u);
+  const auto& corners = findCorners(truth.image, pyramid[2], 1, live, 500, params, buffers);
+  ASSERT_FALSE(corners.empty());
+  for (const auto& c : corners) {
+    EXPECT_LT(nearest(c, truth.corners), 0.25);
+    EXPECT_GE(nearest(c, live), params.min_distance_px) << c;
+  }
+  // Every corner not masked is found: the squares are 20 px, more than 15 px apart.
+  EXPECT_EQ(corners.size(), truth.corners.size() - live.size());
+}
+
+TEST(CornerSearch, NothingWantedOrNothingToFind) {
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const cv::Mat flat(240, 320, CV_8UC1, cv::Scalar(90));
+  EXPECT_TRUE(findCorners(flat, flat, 0, {}, 50, params, buffers).empty());
+  const Squares truth = squares({320, 240});
+  EXPECT_TRUE(findCorners(truth.image, truth.image, 0, {}, 0, params, buffers).empty());
+}
+
+TEST(CornerSearch, ShiTomasiScoreMatchesOpenCVsMinEigenValue) {
+  // cornerMinEigenVal uses Sobel derivatives scaled by 1/(4 * 255 * block): the score of
+  // the Scharr derivatives differs by a constant factor, so the order is the same.
+  const Squares truth = squares({320, 240});
+  cv::Mat derivatives(truth.image.size(), CV_16SC2);
+  cv::Mat dx, dy;
+  cv::Sobel(truth.image, dx, CV_16S, 1, 0, 3);
+  cv::Sobel(truth.image, dy, CV_16S, 0, 1, 3);
+  cv::merge(std::vector<cv::Mat>{dx, dy}, derivatives);
+  cv::Mat eig;
+  cv::cornerMinEigenVal(truth.image, eig, 3, 3);
+  const double scale = 1.0 / (4.0 * 255.0 * 3.0);
+  for (const cv::Point p : {cv::Point(60, 60), cv::Point(59, 40), cv::Point(40, 40), cv::Point(100, 15),
+                            cv::Point(49, 49), cv::Point(90, 40)}) {
+    const double ours = shiTomasiScore(derivatives, p, 3) * scale * scale;
+    EXPECT_NEAR(ours, eig.at<float>(p), 1e-4 + 1e-3 * eig.at<float>(p)) << p;
+  }
+  // A corner scores high, an edge and a flat area do not.
+  EXPECT_GT(shiTomasiScore(derivatives, truth.corners[0], 3), 1e4);
+  EXPECT_LT(shiTomasiScore(derivatives, {50, 30}, 3), 1.0);   // flat
+  EXPECT_LT(shiTomasiScore(derivatives, {50, 60}, 3), 1e-6 + shiTomasiScore(derivatives, truth.corners[0], 3) / 100);  // edge
+}
+
+namespace {
+
+// Squares on the left half; on the right half a checkerboard of 2 px cells and
+// `contrast` grey levels, which pyrDown averages down to 1/16 of its contrast (1/256 of
+// the corner score): its corners are strong at full resolution only.
+cv::Mat squaresAndFineCheckerboard(int contrast) {
+  cv::Mat image = squares({640, 480}).image;
+  image.colRange(320, 640).setTo(40);
+  for (int y = 40; y < 440; ++y)
+    for (int x = 360; x < 600; ++x)
+      if ((x / 2 + y / 2) % 2) image.at<uchar>(y, x) = static_cast<uchar>(40 + contrast);
+  return image;
+}
+
+}  // namespace
+
+TEST(CornerSearch, FullResolutionFillsWhatTheCoarseLevelLacks) {
+  const cv::Mat image = squaresAndFineCheckerboard(160);
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const auto& corners = findCorners(image, pyramid[2], 1, {}, 400, params, buffers, &pyramid[1]);
+  // The fill's corners come last: all on the checkerboard (the coarse level sees only
+  // its outline's four corners).
+  EXPECT_GT(buffers.from_full_resolution, 100);
+  ASSERT_LE(buffers.from_full_resolution, static_cast<int>(corners.size()));
+  for (size_t i = corners.size() - buffers.from_full_resolution; i < corners.size(); ++i)
+    EXPECT_TRUE(cv::Rect(358, 38, 244, 404).contains(corners[i])) << corners[i];
+  int coarse_on_board = 0;
+  for (size_t i = 0; i < corners.size() - buffers.from_full_resolution; ++i)
+    coarse_on_board += corners[i].x > 340;
+  EXPECT_LE(coarse_on_board, 4);
+  for (size_t i = 0; i < corners.size(); ++i)
+    for (size_t j = i + 1; j < corners.size(); ++j)
+      EXPECT_GE(cv::norm(corners[i] - corners[j]), params.min_distance_px);
+}
+
+TEST(CornerSearch, FillKeepsTheQualityBarOfTheWholeImage) {
+  // A faint checkerboard (2 grey levels) scores far below 1 % of the squares' corners:
+  // a search of the whole image would not take it, nor does the fill.
+  const cv::Mat image = squaresAndFineCheckerboard(2);
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const auto& corners = findCorners(image, pyramid[2], 1, {}, 400, params, buffers, &pyramid[1]);
+  ASSERT_FALSE(corners.empty());
+  for (const auto& c : corners) EXPECT_LT(c.x, 340) << c;
+  EXPECT_EQ(buffers.from_full_resolution, 0);
+}
