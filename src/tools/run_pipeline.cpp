@@ -15,6 +15,8 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "mono_plane_detection/sim/scene_renderer.h"
 #include "mono_plane_detection/tracking/target_startup.h"
+#include "mono_plane_detection/viz/draw_planes.h"
+#include <opencv2/imgcodecs.hpp>
 
 using namespace mono_plane_detection;
 
@@ -50,17 +52,27 @@ int main(int argc, char** argv) {
       "  Renders a room seen from a moving camera and runs tracker + planes + map on it,\n"
       "  then prints each mapped plane against the ground truth and the camera path error.",
       "exit codes: 0 every true plane mapped once, 1 a plane missed or split, 2 bad usage\n");
-  cli.choice("trajectory", &trajectory.name, {"wheeled", "humanoid", "rotation"},
-             "camera motion")
+  RoomParams room;
+  std::string textures, save_dir;
+  int save_every = 0;
+  cli.choice("trajectory", &trajectory.name,
+             {"wheeled", "humanoid", "rotation", "turn_in_place", "look_around"}, "camera motion")
+      .choice("layout", &room.layout, {"bare", "furnished"}, "the room (make_sequence --layout)")
+      .text("textures", &textures, "paint floor and walls with the photographs in DIR", "DIR")
+      .choice("background", &room.target_background, {"black", "grey", "wood"},
+              "around the start-up sheet")
       .integer("frames", &frames, 1, 1000000, "images per loop")
       .number("fps", &fps, 0.1, 1000.0, "images per second", "F")
       .number("noise", &render.noise_sigma, 0.0, 255.0, "image noise sigma, grey levels", "SIGMA")
       .integer<unsigned>("seed", &seed, 0, std::numeric_limits<unsigned>::max(),
                          "room textures and humanoid jerks", "S")
-      .integer("frame-gap", &frame_gap, 1, 1000, "frames between the two views of the planes")
+      .integer("frame-gap", &frame_gap, 1, 1000,
+               "frames between the two views of the planes before the camera is placed")
       .integer("width", &camera.size.width, 64, 4096, "image width, pixels", "W")
       .integer("height", &camera.size.height, 48, 4096, "image height, pixels", "H")
       .integer("features", &features, 5, 10000, "the tracker's max_features")
+      .text("save-dir", &save_dir, "write overlays (planes drawn) here, with --save-every", "DIR")
+      .integer("save-every", &save_every, 0, 1000000, "an overlay every N images (0: none)")
       .integer("report-every", &report_every, 0, 1000000,
                "print the state every N frames (0: only the end)")
       .integer("loop", &loops, 1, 100000,
@@ -73,11 +85,18 @@ int main(int argc, char** argv) {
   camera.cy = (camera.size.height - 1) / 2.0;
   trajectory.seed = seed;
 
-  RoomParams room;
   room.seed = seed;
+  if (!textures.empty()) {
+    try {
+      room.photos = loadTexturePhotos(textures);
+    } catch (const std::exception& e) {
+      return cli.fail(std::string("--textures: ") + e.what());
+    }
+  }
   const IndoorScene scene = makeRoom(room);
   const SceneRenderer renderer(scene, camera, render);
   std::vector<TruthPlane> truth = truthPlanes(scene);
+  std::vector<double> range(truth.size(), 1.0);
   const Pose map_from_world = scene.target.world_from_map.inverse();
 
   TrackerParams tracker_params;
@@ -111,7 +130,13 @@ int main(int argc, char** argv) {
       if (loop == 0) {
         const std::vector<double> shares = imageShares(scene, camera, world_from_camera, 16);
         for (size_t p = 0; p < truth.size(); ++p)
-          truth[p].max_image_share = std::max(truth[p].max_image_share, shares[p]);
+          if (shares[p] > truth[p].max_image_share) {
+            truth[p].max_image_share = shares[p];
+            // Relative distance errors are judged against the camera's distance from
+            // the plane where it filled the image most.
+            range[p] = std::abs(scene.planes[p].normal().dot(world_from_camera.t) -
+                                scene.planes[p].distance());
+          }
       }
       const cv::Mat image = renderer.render(world_from_camera, seed * 100000u + k);
       const auto t0 = Clock::now();
@@ -142,6 +167,11 @@ int main(int argc, char** argv) {
         ++posed;
       }
       tracking += result.state == PipelineState::kTracking;
+      if (save_every > 0 && !save_dir.empty() && k % save_every == 0 && loop == 0) {
+        char name[64];
+        std::snprintf(name, sizeof(name), "/overlay_%04d.png", k);
+        cv::imwrite(save_dir + name, drawPlanes(image, result));
+      }
       if (report_every > 0 && (k + 1) % report_every == 0)
         std::printf(
             "  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
@@ -170,16 +200,23 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < confirmed.size(); ++i) {
       const MapPlane& p = confirmed[i];
       const PlaneMatch& m = eval.matches[i];
+      double relative = 0;
+      for (size_t t = 0; t < truth.size(); ++t)
+        if (truth[t].id == m.truth_id) relative = m.distance_error_m / range[t];
       std::printf(
           "  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
-          "(normal %.2f deg, distance %.3f m)\n",
+          "(normal %.2f deg, distance %.3f m = %.1f %%)\n",
           p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(), p.observations,
           m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH", m.normal_error_deg,
-          m.distance_error_m);
+          m.distance_error_m, 100 * relative);
     }
     for (const TruthPlane& t : truth)
-      std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
-                  t.normal[0], t.normal[1], t.normal[2], t.distance, 100 * t.max_image_share);
+      if (t.max_image_share >= 0.02)
+        std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
+                    t.normal[0], t.normal[1], t.normal[2], t.distance, 100 * t.max_image_share);
+    int false_planes = 0;
+    for (const PlaneMatch& m : eval.matches) false_planes += m.truth_id < 0;
+    std::printf("false planes %d\n", false_planes);
     for (int id : eval.missed) std::printf("  missed: true plane %d\n", id);
     std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
