@@ -214,7 +214,15 @@ const ParamTable<MapParams>& mapParamTable() {
       {"min_shared_ids", field(&P::min_shared_ids), 0, 1, "",
        "or this share of the observation's tracks already on the plane"},
       {"confirm_observations", field(&P::confirm_observations), 1, 10000, "",
-       "a plane is confirmed after this many images", "confirm_observations"},
+       "a plane is confirmed after observations from this many viewpoints",
+       "confirm_observations"},
+      {"view_spacing", field(&P::view_spacing), 0, 10, "",
+       "an observation counts only from this share of the plane's distance away from the "
+       "viewpoints counted before"},
+      {"coplanar_sigmas", field(&P::coplanar_sigmas), 0.1, 100, "",
+       "a 3D point is on a plane within this many standard deviations of its depth"},
+      {"min_residual_m", field(&P::min_residual_m), 0, 10, "m",
+       "the coplanarity tolerance of a perfectly triangulated point"},
       {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",
        "unconfirmed planes unseen for this long are removed", "tentative_timeout_s"},
       {"fade_time_s", field(&P::fade_time_s), 1e-3, 1e6, "s",
@@ -232,7 +240,15 @@ const ParamTable<PipelineParams>& pipelineParamTable() {
   static const ParamTable<P> table = [] {
     ParamTable<P> t{
         {"frame_gap", field(&P::frame_gap), 1, 1000, "images",
-         "homographies map the image this many images back to this one"},
+         "without intrinsics: homographies map the image this many images back to this one"},
+        {"keyframe_parallax_px", field(&P::keyframe_parallax_px), 0, 1000, "px",
+         "the reference image is the most recent one with this much rotation-free parallax"},
+        {"min_parallax_px", field(&P::min_parallax_px), 0, 1000, "px",
+         "less to every image within reach (pure rotation, standing still): no planes"},
+        {"max_keyframe_age", field(&P::max_keyframe_age), 1, 1000, "images",
+         "images kept to choose the reference from"},
+        {"min_keyframe_shared", field(&P::min_keyframe_shared), 0, 1, "",
+         "share of this image's tracks a reference must still hold"},
         {"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
          "a longer pause between tracks messages is a tracking loss"},
     };

@@ -8,6 +8,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "mono_plane_detection/geometry/plane_fit.h"
+
 namespace mono_plane_detection {
 
 struct MapParams {
@@ -19,6 +21,13 @@ struct MapParams {
   double max_offset_m = 0.15;         // association / merge gate on the distance between planes
   double min_shared_ids = 0.3;        // or: this share of the observation's tracks already on it
   int confirm_observations = 3;       // a plane is confirmed after this many observations
+  // An observation counts only from a viewpoint at least this share of the plane's
+  // distance away from every view counted before (3 images of one spot do not confirm).
+  double view_spacing = 0.03;
+  // A point is on a plane within this many standard deviations of its position along
+  // the viewing ray (PlaneObservation::sigma_m), never beyond max_residual_m.
+  double coplanar_sigmas = 3.0;
+  double min_residual_m = 0.005;      // the tolerance of a perfectly triangulated point
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -30,6 +39,10 @@ struct PlaneObservation {
   std::vector<std::uint64_t> ids;  // tracks on the plane with a 3D position
   std::vector<cv::Vec3d> points;   // their positions, map frame, m
   cv::Vec3d viewpoint;             // camera centre, map frame (orients the normal)
+  // Per point: standard deviation of its position along the viewing ray (m), from the
+  // landmark's parallax and the pose's reprojection error. Empty: unknown, every point
+  // gets max_residual_m.
+  std::vector<double> sigma_m;
 };
 
 struct MapPlane {
@@ -38,7 +51,8 @@ struct MapPlane {
   double distance = 0;             // m: the plane is {x : normal . x = distance}
   double rms_m = 0;                // fit over its points
   std::vector<cv::Vec3d> polygon;  // convex hull of its points, map frame
-  int observations = 0;
+  int observations = 0;               // from distinct viewpoints (MapParams::view_spacing)
+  std::vector<cv::Vec3d> views;      // the viewpoints counted, map frame
   double first_seen = 0, last_seen = 0;  // stamps, s
   double confidence = 0;                 // 0..1: grows with observations, fades unseen
   // Track id -> latest position and the stamp it was seen on the plane.
@@ -61,6 +75,10 @@ class PlaneMap {
   void reset();
 
  private:
+  // Each point's tolerance from the plane with this normal (coplanar_sigmas x its
+  // uncertainty across the plane, within [min_residual_m, max_residual_m]).
+  std::vector<double> tolerances(const PlaneObservation& obs, const cv::Vec3d& normal) const;
+  PlaneFit fitObservation(const PlaneObservation& obs, int needed) const;
   int fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance, double stamp);
   int associate(const cv::Vec3d& normal, double distance, const PlaneObservation& obs) const;
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint) const;
