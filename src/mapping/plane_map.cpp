@@ -41,6 +41,53 @@ bool leastSquares(const std::vector<cv::Vec3d>& points, cv::Vec3d& normal, doubl
   return std::isfinite(distance);
 }
 
+// Two groups of points on parallel surfaces (a shelf front and the wall beside it),
+// each seen as a narrow strip, always lie on one plane: a tilted one through both. Such
+// a plane's points fall into two groups with a gap between them along some direction
+// in the plane, and at least one group, fitted alone, is not that plane (or is a strip
+// that cannot say). True when the points do that: the plane is not taken.
+bool looksLikeTwoSurfaces(const std::vector<cv::Vec3d>& points, const cv::Vec3d& normal,
+                          double max_residual_m, double min_gap_m) {
+  if (points.size() < 8) return false;
+  cv::Vec3d u, v;
+  planeAxes(normal, u, v);
+  for (int step = 0; step < 8; ++step) {  // directions every 22.5 deg in the plane
+    const double a = step * CV_PI / 8;
+    const cv::Vec3d dir = std::cos(a) * u + std::sin(a) * v;
+    std::vector<std::pair<double, size_t>> along;
+    for (size_t i = 0; i < points.size(); ++i) along.emplace_back(dir.dot(points[i]), i);
+    std::sort(along.begin(), along.end());
+    const size_t quarter = points.size() / 4;
+    for (size_t k = quarter; k + quarter < points.size(); ++k) {
+      if (along[k].first - along[k - 1].first < min_gap_m) continue;
+      // A gap with at least a quarter of the points on each side: fit each side alone.
+      for (int side = 0; side < 2; ++side) {
+        std::vector<cv::Vec3d> group;
+        for (size_t j = side == 0 ? 0 : k; j < (side == 0 ? k : points.size()); ++j)
+          group.push_back(points[along[j].second]);
+        cv::Vec3d n;
+        double d;
+        if (!leastSquares(group, n, d)) return true;
+        // Spread of the group across its own line: a strip cannot confirm the plane.
+        cv::Vec3d centroid(0, 0, 0);
+        for (const auto& p : group) centroid += p;
+        centroid *= 1.0 / static_cast<double>(group.size());
+        cv::Matx33d scatter = cv::Matx33d::zeros();
+        for (const auto& p : group) {
+          const cv::Vec3d q = p - centroid;
+          scatter += q * q.t();
+        }
+        cv::Mat values;
+        cv::eigen(cv::Mat(scatter * (1.0 / group.size())), values);
+        const double width = std::sqrt(std::max(0.0, values.at<double>(1)));
+        const double angle = normalAngleDeg(n, normal);
+        if (width < 4 * max_residual_m || std::min(angle, 180 - angle) > 10) return true;
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 std::vector<double> PlaneMap::tolerances(const PlaneObservation& obs,
@@ -52,6 +99,10 @@ std::vector<double> PlaneMap::tolerances(const PlaneObservation& obs,
     cv::Vec3d ray = obs.points[i] - obs.viewpoint;
     const double length = cv::norm(ray);
     const double across = length > 0 ? std::abs(normal.dot(ray)) / length : 1.0;
+    if (obs.sigma_m[i] * across > params_.max_point_sigma_m) {
+      tol[i] = -1;  // too uncertain across this plane to test it
+      continue;
+    }
     const double sigma = std::hypot(obs.sigma_m[i] * across, params_.min_residual_m / 3);
     tol[i] = std::min(params_.max_residual_m,
                       std::max(params_.min_residual_m, params_.coplanar_sigmas * sigma));
@@ -78,6 +129,7 @@ PlaneFit PlaneMap::fitObservation(const PlaneObservation& obs, int needed) const
     size_t count = 0;
     double cost = 0;
     for (int i = 0; i < n; ++i) {
+      if (tol[i] < 0) continue;
       const double r = std::abs(normal.dot(obs.points[i]) - distance) / tol[i];
       if (r <= 1) {
         ++count;
@@ -118,6 +170,7 @@ PlaneFit PlaneMap::fitObservation(const PlaneObservation& obs, int needed) const
   // The spread check and the final least squares of fitPlane on the inliers.
   std::vector<cv::Vec3d> in;
   for (int i : inliers) in.push_back(obs.points[i]);
+  if (looksLikeTwoSurfaces(in, best_normal, params_.max_residual_m, params_.min_gap_m)) return best;
   const PlaneFit check = fitPlane(in, params_.max_residual_m, needed);
   if (!check.ok) return best;
   best.ok = true;

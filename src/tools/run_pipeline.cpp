@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <limits>
 #include <string>
 
@@ -209,6 +210,27 @@ int main(int argc, char** argv) {
           p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(), p.observations,
           m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH", m.normal_error_deg,
           m.distance_error_m, 100 * relative);
+      // What its points are: the true surface nearest to each (a mixture shows here).
+      std::map<std::string, int> made_of;
+      for (const auto& [id, entry] : p.points) {
+        const cv::Vec3d x = scene.target.world_from_map.apply(entry.first);
+        std::string best = "nothing";
+        double best_d = 0.05;
+        for (const ScenePlane& sp : scene.planes) {
+          const double dist = std::abs(sp.normal().dot(x) - sp.distance());
+          const cv::Vec3d local = x - sp.origin;
+          const double a = local.dot(sp.u_axis), b = local.dot(sp.v_axis);
+          if (a < -0.05 || b < -0.05 || a > sp.width_m + 0.05 || b > sp.height_m + 0.05) continue;
+          if (dist < best_d) {
+            best_d = dist;
+            best = sp.name;
+          }
+        }
+        ++made_of[best];
+      }
+      std::printf("    points on:");
+      for (const auto& [name, count] : made_of) std::printf(" %s %d", name.c_str(), count);
+      std::printf("\n");
     }
     for (const TruthPlane& t : truth)
       if (t.max_image_share >= 0.02)

@@ -174,3 +174,27 @@ TEST(PlaneMap, MixturesAreSplitAtTheLandmarksUncertainty) {
     }
   }
 }
+
+// Issue 18: a shelf front and the wall beside it, each seen as a narrow vertical strip,
+// lie on one tilted plane through both (two parallel lines always do). That plane
+// is not taken; without it (the old rule) a plane tilted by tens of degrees was mapped.
+TEST(PlaneMap, TwoStripsOnParallelSurfacesAreNotOneTiltedPlane) {
+  PlaneObservation obs;
+  obs.viewpoint = {2.0, 0.3, 1.0};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> across(0, 0.08), up(0, 1.5);
+  for (int i = 0; i < 40; ++i) {
+    const bool shelf = i % 2 == 0;
+    obs.ids.push_back(100 + i);
+    obs.points.push_back({shelf ? 0.35 : 0.0, (shelf ? 0.7 : 0.0) + across(rng), up(rng)});
+  }
+  PlaneMap old_rule;
+  ASSERT_GE(old_rule.update({obs}, 1000)[0], 0);  // no uncertainties: one plane
+  const double tilt = normalAngleDeg(old_rule.planes()[0].normal, cv::Vec3d(1, 0, 0));
+  EXPECT_GT(tilt, 20.0);
+  obs.sigma_m.assign(obs.points.size(), 0.003);
+  PlaneMap map;
+  map.update({obs}, 1000);
+  for (const MapPlane& p : map.planes())
+    EXPECT_LT(normalAngleDeg(p.normal, cv::Vec3d(1, 0, 0)), 10.0) << "plane " << p.id;
+}

@@ -28,6 +28,13 @@ struct MapParams {
   // the viewing ray (PlaneObservation::sigma_m), never beyond max_residual_m.
   double coplanar_sigmas = 3.0;
   double min_residual_m = 0.005;      // the tolerance of a perfectly triangulated point
+  // Points known less well than this across the plane (their uncertainty along the ray
+  // times the ray's angle to the plane) cannot test coplanarity: they wait outside the
+  // map until retriangulated with more parallax.
+  double max_point_sigma_m = 0.05;  // = max_residual_m: 0.02-0.03 lost far walls (measured)
+  // A plane whose points fall into two groups this far apart, one of which alone is not
+  // that plane (or only a strip), is two surfaces: not taken.
+  double min_gap_m = 0.25;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -76,7 +83,8 @@ class PlaneMap {
 
  private:
   // Each point's tolerance from the plane with this normal (coplanar_sigmas x its
-  // uncertainty across the plane, within [min_residual_m, max_residual_m]).
+  // uncertainty across the plane, within [min_residual_m, max_residual_m]); -1 for a
+  // point too uncertain across it (max_point_sigma_m).
   std::vector<double> tolerances(const PlaneObservation& obs, const cv::Vec3d& normal) const;
   PlaneFit fitObservation(const PlaneObservation& obs, int needed) const;
   int fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance, double stamp);
