@@ -18,6 +18,7 @@
 #include "mono_plane_detection/tracking/target_startup.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 using namespace mono_plane_detection;
 
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
       "  then prints each mapped plane against the ground truth and the camera path error.",
       "exit codes: 0 every true plane mapped once, 1 a plane missed or split, 2 bad usage\n");
   RoomParams room;
-  std::string textures, save_dir;
+  std::string textures, save_dir, top_view;
   int save_every = 0;
   cli.choice("trajectory", &trajectory.name,
              {"wheeled", "humanoid", "rotation", "turn_in_place", "look_around"}, "camera motion")
@@ -74,6 +75,8 @@ int main(int argc, char** argv) {
       .integer("features", &features, 5, 10000, "the tracker's max_features")
       .text("save-dir", &save_dir, "write overlays (planes drawn) here, with --save-every", "DIR")
       .integer("save-every", &save_every, 0, 1000000, "an overlay every N images (0: none)")
+      .text("top-view", &top_view,
+            "write a top view (room, furniture, confirmed planes, camera paths) as PNG", "FILE")
       .integer("report-every", &report_every, 0, 1000000,
                "print the state every N frames (0: only the end)")
       .integer("loop", &loops, 1, 100000,
@@ -123,6 +126,7 @@ int main(int argc, char** argv) {
     tracker.reset();
     startup.reset();
     double track_ms = 0, plane_ms = 0, travelled = 0, pos_err_sum = 0, pos_err_max = 0;
+    std::vector<cv::Vec3d> path_truth, path_estimate;  // world frame
     int posed = 0, tracking = 0;
     cv::Vec3d last_position;
     for (int k = 0; k < frames; ++k) {
@@ -157,6 +161,9 @@ int main(int argc, char** argv) {
       track_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
       plane_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
       const Pose truth_pose = map_from_world * world_from_camera;
+      path_truth.push_back(world_from_camera.t);
+      if (result.pose)
+        path_estimate.push_back(scene.target.world_from_map.apply(result.pose->map_from_camera.t));
       if (k > 0) travelled += cv::norm(truth_pose.t - last_position);
       last_position = truth_pose.t;
       double frame_err = -1;
@@ -244,6 +251,36 @@ int main(int argc, char** argv) {
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
                 eval.worst_distance_error_m);
     exit_code = eval.missed.empty() && eval.split.empty() ? 0 : 1;
+    if (!top_view.empty()) {
+      // Seen from above, world x to the right, y up the image, 80 px per metre.
+      const double scale = 80, x0 = -room.width_m / 2 - 0.3, y1 = room.front_m + 0.3;
+      cv::Mat view(static_cast<int>((room.front_m + room.back_m + 0.6) * scale),
+                   static_cast<int>((room.width_m + 0.6) * scale), CV_8UC3, cv::Scalar(255, 255, 255));
+      auto px = [&](const cv::Vec3d& x) {
+        return cv::Point(static_cast<int>((x[0] - x0) * scale), static_cast<int>((y1 - x[1]) * scale));
+      };
+      for (const ScenePlane& sp : scene.planes) {
+        if (sp.name == "ceiling") continue;
+        const auto c = sp.corners();
+        std::vector<cv::Point> poly;
+        for (const auto& v : c) poly.push_back(px(v));
+        if (std::abs(sp.normal()[2]) > 0.9) {
+          if (sp.name != "floor") cv::fillConvexPoly(view, poly, cv::Scalar(225, 225, 225));
+        } else {
+          cv::polylines(view, poly, true, cv::Scalar(0, 0, 0), 2);
+        }
+      }
+      for (const MapPlane& p : confirmed) {
+        std::vector<cv::Point> poly;
+        for (const auto& v : p.polygon) poly.push_back(px(scene.target.world_from_map.apply(v)));
+        if (poly.size() >= 2) cv::polylines(view, poly, true, planeColour(p.id), 2);
+      }
+      for (size_t k = 1; k < path_truth.size(); ++k)
+        cv::line(view, px(path_truth[k - 1]), px(path_truth[k]), cv::Scalar(120, 120, 120), 2);
+      for (size_t k = 1; k < path_estimate.size(); ++k)
+        cv::line(view, px(path_estimate[k - 1]), px(path_estimate[k]), cv::Scalar(0, 0, 255), 1);
+      cv::imwrite(top_view, view);
+    }
   }
   return exit_code;
 }
