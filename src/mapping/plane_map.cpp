@@ -88,6 +88,26 @@ bool looksLikeTwoSurfaces(const std::vector<cv::Vec3d>& points, const cv::Vec3d&
   return false;
 }
 
+// How well the points fix the normal: the tilt about the points' long in-plane axis
+// that moves them by their rms, shrunk by sqrt(points). A strip of points (one seen edge
+// on, or a narrow band of a larger surface) leaves the plane free to turn about it.
+double normalSigmaDeg(const std::vector<cv::Vec3d>& points, double rms_m, double floor_m) {
+  if (points.size() < 3) return 180;
+  cv::Vec3d centroid(0, 0, 0);
+  for (const auto& p : points) centroid += p;
+  centroid *= 1.0 / static_cast<double>(points.size());
+  cv::Matx33d scatter = cv::Matx33d::zeros();
+  for (const auto& p : points) {
+    const cv::Vec3d q = p - centroid;
+    scatter += q * q.t();
+  }
+  cv::Mat values;
+  cv::eigen(cv::Mat(scatter * (1.0 / static_cast<double>(points.size()))), values);
+  const double minor = std::sqrt(std::max(1e-12, values.at<double>(1)));
+  const double sigma = std::max(rms_m, floor_m) / std::sqrt(static_cast<double>(points.size()));
+  return std::atan2(sigma, minor) * 180 / CV_PI;
+}
+
 }  // namespace
 
 std::vector<double> PlaneMap::tolerances(const PlaneObservation& obs,
@@ -333,6 +353,7 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
   plane.distance = fit.distance;
   plane.rms_m = fit.rms_m;
   plane.polygon = planePolygon(fit.normal, fit.distance, inliers);
+  plane.normal_sigma_deg = normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m);
   return true;
 }
 

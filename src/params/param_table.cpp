@@ -225,6 +225,8 @@ const ParamTable<MapParams>& mapParamTable() {
        "the coplanarity tolerance of a perfectly triangulated point"},
       {"max_point_sigma_m", field(&P::max_point_sigma_m), 0, 10, "m",
        "points less certain across a plane than this do not test it"},
+      {"max_normal_sigma_deg", field(&P::max_normal_sigma_deg), 0, 180, "deg",
+       "and only once its points fix its normal to this (1 sigma)"},
       {"min_gap_m", field(&P::min_gap_m), 0, 100, "m",
        "a plane's points in two groups this far apart, one not that plane alone: refused"},
       {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",

@@ -235,7 +235,7 @@ int main(int argc, char** argv) {
         }
         ++made_of[best];
       }
-      std::printf("    points on:");
+      std::printf("    normal sigma %.2f deg, rms %.3f m; points on:", p.normal_sigma_deg, p.rms_m);
       for (const auto& [name, count] : made_of) std::printf(" %s %d", name.c_str(), count);
       std::printf("\n");
     }

@@ -124,8 +124,9 @@ TEST(FurnishedRoom, WheeledPath) {
 
 TEST(FurnishedRoom, HumanoidPath) {
   const RoomRun run = runFurnished("humanoid");
-  // Measured: 1 (a plane through shelf-front and left-wall points, issue 18 open).
-  EXPECT_LE(falsePlanes(run.eval), 1);
+  // The one plane that matched nothing (19 shelf-front points in a strip, 20 deg off) has
+  // normal_sigma_deg 1.08 against max_normal_sigma_deg 1.0: not confirmed.
+  EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
   for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;

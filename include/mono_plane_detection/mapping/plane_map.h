@@ -35,6 +35,9 @@ struct MapParams {
   // A plane whose points fall into two groups this far apart, one of which alone is not
   // that plane (or only a strip), is two surfaces: not taken.
   double min_gap_m = 0.25;
+  // And only once its points fix its normal to this (1 sigma, normal_sigma_deg): half the
+  // 2 deg a mapped plane may be off. A strip of points leaves the plane free to turn.
+  double max_normal_sigma_deg = 1.0;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -57,6 +60,9 @@ struct MapPlane {
   cv::Vec3d normal{0, 0, 1};       // unit, towards the side it was seen from
   double distance = 0;             // m: the plane is {x : normal . x = distance}
   double rms_m = 0;                // fit over its points
+  // How well its points fix the normal (deg): rms / sqrt(points) against their spread
+  // across the plane's long axis.
+  double normal_sigma_deg = 180;
   std::vector<cv::Vec3d> polygon;  // convex hull of its points, map frame
   int observations = 0;               // from distinct viewpoints (MapParams::view_spacing)
   std::vector<cv::Vec3d> views;      // the viewpoints counted, map frame
@@ -64,7 +70,9 @@ struct MapPlane {
   double confidence = 0;                 // 0..1: grows with observations, fades unseen
   // Track id -> latest position and the stamp it was seen on the plane.
   std::map<std::uint64_t, std::pair<cv::Vec3d, double>> points;
-  bool confirmed(const MapParams& p) const { return observations >= p.confirm_observations; }
+  bool confirmed(const MapParams& p) const {
+    return observations >= p.confirm_observations && normal_sigma_deg <= p.max_normal_sigma_deg;
+  }
 };
 
 class PlaneMap {
