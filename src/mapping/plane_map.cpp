@@ -396,7 +396,9 @@ void PlaneMap::fadeAndBound(double stamp) {
   }
   planes_.erase(std::remove_if(planes_.begin(), planes_.end(),
                                [&](const MapPlane& p) {
-                                 return !p.confirmed(params_) &&
+                                 // Seen from too few views; one seen from enough but
+                                 // with a loose normal stays (more points may fix it).
+                                 return p.observations < params_.confirm_observations &&
                                         stamp - p.last_seen > params_.tentative_timeout_s;
                                }),
                 planes_.end());
