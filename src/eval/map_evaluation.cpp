@@ -45,12 +45,16 @@ MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector
   for (const MapPlane& plane : planes) {
     PlaneMatch m;
     m.map_id = plane.id;
-    double best_angle = max_angle_deg;
+    // Parallel surfaces (a wall and the door recessed in it, a shelf front before the
+    // wall) differ only in offset: the best match weighs both gates.
+    double best_cost = 2.0;
     for (const TruthPlane& t : truth) {
       const double angle = normalAngleDeg(plane.normal, t.normal);
       const double offset = std::abs(plane.distance - t.distance);
-      if (angle <= best_angle && offset <= max_offset_m) {
-        best_angle = angle;
+      if (angle > max_angle_deg || offset > max_offset_m) continue;
+      const double cost = angle / max_angle_deg + offset / max_offset_m;
+      if (cost < best_cost) {
+        best_cost = cost;
         m.truth_id = t.id;
         m.truth_name = t.name;
         m.normal_error_deg = angle;

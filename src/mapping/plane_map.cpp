@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "mono_plane_detection/geometry/plane_fit.h"
 
@@ -22,7 +23,185 @@ std::vector<cv::Vec3d> positions(const MapPlane& plane) {
   return out;
 }
 
+// Least-squares plane through points (centroid and smallest eigenvector).
+bool leastSquares(const std::vector<cv::Vec3d>& points, cv::Vec3d& normal, double& distance) {
+  if (points.size() < 3) return false;
+  cv::Vec3d centroid(0, 0, 0);
+  for (const auto& p : points) centroid += p;
+  centroid *= 1.0 / static_cast<double>(points.size());
+  cv::Matx33d scatter = cv::Matx33d::zeros();
+  for (const auto& p : points) {
+    const cv::Vec3d d = p - centroid;
+    scatter += d * d.t();
+  }
+  cv::Mat values, vectors;
+  cv::eigen(cv::Mat(scatter), values, vectors);  // descending
+  normal = cv::Vec3d(vectors.at<double>(2, 0), vectors.at<double>(2, 1), vectors.at<double>(2, 2));
+  distance = normal.dot(centroid);
+  return std::isfinite(distance);
+}
+
+// Two groups of points on parallel surfaces (a shelf front and the wall beside it),
+// each seen as a narrow strip, always lie on one plane: a tilted one through both. Such
+// a plane's points fall into two groups with a gap between them along some direction
+// in the plane, and at least one group, fitted alone, is not that plane (or is a strip
+// that cannot say). True when the points do that: the plane is not taken.
+bool looksLikeTwoSurfaces(const std::vector<cv::Vec3d>& points, const cv::Vec3d& normal,
+                          double max_residual_m, double min_gap_m) {
+  if (points.size() < 8) return false;
+  cv::Vec3d u, v;
+  planeAxes(normal, u, v);
+  for (int step = 0; step < 8; ++step) {  // directions every 22.5 deg in the plane
+    const double a = step * CV_PI / 8;
+    const cv::Vec3d dir = std::cos(a) * u + std::sin(a) * v;
+    std::vector<std::pair<double, size_t>> along;
+    for (size_t i = 0; i < points.size(); ++i) along.emplace_back(dir.dot(points[i]), i);
+    std::sort(along.begin(), along.end());
+    const size_t quarter = points.size() / 4;
+    for (size_t k = quarter; k + quarter < points.size(); ++k) {
+      if (along[k].first - along[k - 1].first < min_gap_m) continue;
+      // A gap with at least a quarter of the points on each side: fit each side alone.
+      for (int side = 0; side < 2; ++side) {
+        std::vector<cv::Vec3d> group;
+        for (size_t j = side == 0 ? 0 : k; j < (side == 0 ? k : points.size()); ++j)
+          group.push_back(points[along[j].second]);
+        cv::Vec3d n;
+        double d;
+        if (!leastSquares(group, n, d)) return true;
+        // Spread of the group across its own line: a strip cannot confirm the plane.
+        cv::Vec3d centroid(0, 0, 0);
+        for (const auto& p : group) centroid += p;
+        centroid *= 1.0 / static_cast<double>(group.size());
+        cv::Matx33d scatter = cv::Matx33d::zeros();
+        for (const auto& p : group) {
+          const cv::Vec3d q = p - centroid;
+          scatter += q * q.t();
+        }
+        cv::Mat values;
+        cv::eigen(cv::Mat(scatter * (1.0 / group.size())), values);
+        const double width = std::sqrt(std::max(0.0, values.at<double>(1)));
+        const double angle = normalAngleDeg(n, normal);
+        if (width < 4 * max_residual_m || std::min(angle, 180 - angle) > 10) return true;
+      }
+    }
+  }
+  return false;
+}
+
+// How well the points fix the normal: the tilt about the points' long in-plane axis
+// that moves them by their rms, shrunk by sqrt(points). A strip of points (one seen edge
+// on, or a narrow band of a larger surface) leaves the plane free to turn about it.
+double normalSigmaDeg(const std::vector<cv::Vec3d>& points, double rms_m, double floor_m) {
+  if (points.size() < 3) return 180;
+  cv::Vec3d centroid(0, 0, 0);
+  for (const auto& p : points) centroid += p;
+  centroid *= 1.0 / static_cast<double>(points.size());
+  cv::Matx33d scatter = cv::Matx33d::zeros();
+  for (const auto& p : points) {
+    const cv::Vec3d q = p - centroid;
+    scatter += q * q.t();
+  }
+  cv::Mat values;
+  cv::eigen(cv::Mat(scatter * (1.0 / static_cast<double>(points.size()))), values);
+  const double minor = std::sqrt(std::max(1e-12, values.at<double>(1)));
+  const double sigma = std::max(rms_m, floor_m) / std::sqrt(static_cast<double>(points.size()));
+  return std::atan2(sigma, minor) * 180 / CV_PI;
+}
+
 }  // namespace
+
+std::vector<double> PlaneMap::tolerances(const PlaneObservation& obs,
+                                         const cv::Vec3d& normal) const {
+  std::vector<double> tol(obs.points.size(), params_.max_residual_m);
+  if (obs.sigma_m.size() != obs.points.size()) return tol;
+  for (size_t i = 0; i < obs.points.size(); ++i) {
+    // The depth error moves the point along its ray: across the plane by |n . ray|.
+    cv::Vec3d ray = obs.points[i] - obs.viewpoint;
+    const double length = cv::norm(ray);
+    const double across = length > 0 ? std::abs(normal.dot(ray)) / length : 1.0;
+    if (obs.sigma_m[i] * across > params_.max_point_sigma_m) {
+      tol[i] = -1;  // too uncertain across this plane to test it
+      continue;
+    }
+    const double sigma = std::hypot(obs.sigma_m[i] * across, params_.min_residual_m / 3);
+    tol[i] = std::min(params_.max_residual_m,
+                      std::max(params_.min_residual_m, params_.coplanar_sigmas * sigma));
+  }
+  return tol;
+}
+
+PlaneFit PlaneMap::fitObservation(const PlaneObservation& obs, int needed) const {
+  if (obs.sigma_m.size() != obs.points.size())
+    return fitPlane(obs.points, params_.max_residual_m, needed);
+  // RANSAC on triples with each point's own tolerance: well-triangulated points of two
+  // surfaces a few centimetres apart (a shelf before its wall) are not one plane.
+  PlaneFit best;
+  const int n = static_cast<int>(obs.points.size());
+  if (n < std::max(3, needed)) return best;
+  std::mt19937 rng(12345);  // deterministic for given points
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  size_t best_count = 0;
+  double best_cost = 0;
+  cv::Vec3d best_normal;
+  double best_distance = 0;
+  auto score = [&](const cv::Vec3d& normal, double distance, std::vector<int>* inliers) {
+    const std::vector<double> tol = tolerances(obs, normal);
+    size_t count = 0;
+    double cost = 0;
+    for (int i = 0; i < n; ++i) {
+      if (tol[i] < 0) continue;
+      const double r = std::abs(normal.dot(obs.points[i]) - distance) / tol[i];
+      if (r <= 1) {
+        ++count;
+        cost += r * r;
+        if (inliers) inliers->push_back(i);
+      }
+    }
+    return std::make_pair(count, cost);
+  };
+  for (int it = 0; it < 300; ++it) {
+    const int a = pick(rng), b = pick(rng), c = pick(rng);
+    if (a == b || b == c || a == c) continue;
+    cv::Vec3d normal = (obs.points[b] - obs.points[a]).cross(obs.points[c] - obs.points[a]);
+    const double length = cv::norm(normal);
+    if (length < 1e-9) continue;
+    normal /= length;
+    const double distance = normal.dot(obs.points[a]);
+    const auto [count, cost] = score(normal, distance, nullptr);
+    if (count > best_count || (count == best_count && cost < best_cost)) {
+      best_count = count;
+      best_cost = cost;
+      best_normal = normal;
+      best_distance = distance;
+    }
+  }
+  if (static_cast<int>(best_count) < needed) return best;
+  // Refine: least squares on the inliers, inliers again (twice).
+  std::vector<int> inliers;
+  for (int round = 0; round < 3; ++round) {
+    inliers.clear();
+    score(best_normal, best_distance, &inliers);
+    if (static_cast<int>(inliers.size()) < needed) return best;
+    if (round == 2) break;
+    std::vector<cv::Vec3d> in;
+    for (int i : inliers) in.push_back(obs.points[i]);
+    if (!leastSquares(in, best_normal, best_distance)) return best;
+  }
+  // The spread check and the final least squares of fitPlane on the inliers.
+  std::vector<cv::Vec3d> in;
+  for (int i : inliers) in.push_back(obs.points[i]);
+  if (looksLikeTwoSurfaces(in, best_normal, params_.max_residual_m, params_.min_gap_m)) return best;
+  const PlaneFit check = fitPlane(in, params_.max_residual_m, needed);
+  if (!check.ok) return best;
+  best.ok = true;
+  best.normal = best_normal;
+  best.distance = best_distance;
+  best.inliers = inliers;
+  double sum = 0;
+  for (int i : inliers) sum += std::pow(best_normal.dot(obs.points[i]) - best_distance, 2);
+  best.rms_m = std::sqrt(sum / inliers.size());
+  return best;
+}
 
 void PlaneMap::reset() {
   planes_.clear();
@@ -38,9 +217,13 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
     const int needed = std::max(params_.min_points,
                                 static_cast<int>(std::ceil(params_.min_share * obs.points.size())));
     PlaneObservation rest = obs;
+    const bool with_sigma = obs.sigma_m.size() == obs.points.size();
     size_t largest = 0;
+    // An image plane whose 3D points are not one plane (a mixture: under little
+    // parallax several surfaces share a homography) is split into the planes its points
+    // support at their own uncertainty; points on none of them are not mapped.
     while (static_cast<int>(rest.points.size()) >= needed) {
-      PlaneFit fit = fitPlane(rest.points, params_.max_residual_m, needed);
+      PlaneFit fit = fitObservation(rest, needed);
       if (!fit.ok) break;
       orientTowards(fit, obs.viewpoint);
       PlaneObservation kept, others;
@@ -51,6 +234,7 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
         PlaneObservation& to = in[i] ? kept : others;
         to.ids.push_back(rest.ids[i]);
         to.points.push_back(rest.points[i]);
+        if (with_sigma) to.sigma_m.push_back(rest.sigma_m[i]);
       }
       const int id = fuse(kept, fit.normal, fit.distance, stamp);
       if (id >= 0 && kept.points.size() > largest) {
@@ -94,7 +278,17 @@ int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double
     }
     return -1;
   }
-  plane->observations += 1;
+  // Count the observation only from a new viewpoint: images from one spot repeat the
+  // same evidence (and the same mixture, if it is one).
+  const double range = std::max(0.3, std::abs(plane->normal.dot(kept.viewpoint) - plane->distance));
+  const bool new_view = std::all_of(plane->views.begin(), plane->views.end(), [&](const cv::Vec3d& v) {
+    return cv::norm(v - kept.viewpoint) >= params_.view_spacing * range;
+  });
+  if (new_view) {
+    plane->observations += 1;
+    plane->views.push_back(kept.viewpoint);
+    if (plane->views.size() > 16) plane->views.erase(plane->views.begin() + 1);  // bounded
+  }
   plane->last_seen = stamp;
   return plane->id;
 }
@@ -159,6 +353,7 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
   plane.distance = fit.distance;
   plane.rms_m = fit.rms_m;
   plane.polygon = planePolygon(fit.normal, fit.distance, inliers);
+  plane.normal_sigma_deg = normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m);
   return true;
 }
 
@@ -179,6 +374,8 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
       MapPlane merged = a;
       for (const auto& [id, entry] : b.points) merged.points.emplace(id, entry);
       merged.observations += b.observations;
+      merged.views.insert(merged.views.end(), b.views.begin(), b.views.end());
+      if (merged.views.size() > 16) merged.views.resize(16);
       merged.first_seen = std::min(a.first_seen, b.first_seen);
       merged.last_seen = std::max(a.last_seen, b.last_seen);
       if (refit(merged, viewpoint)) {
@@ -199,7 +396,9 @@ void PlaneMap::fadeAndBound(double stamp) {
   }
   planes_.erase(std::remove_if(planes_.begin(), planes_.end(),
                                [&](const MapPlane& p) {
-                                 return !p.confirmed(params_) &&
+                                 // Seen from too few views; one seen from enough but
+                                 // with a loose normal stays (more points may fix it).
+                                 return p.observations < params_.confirm_observations &&
                                         stamp - p.last_seen > params_.tentative_timeout_s;
                                }),
                 planes_.end());

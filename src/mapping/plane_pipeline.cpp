@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 #include <sstream>
+#include <unordered_map>
 #include <unordered_set>
 
 namespace mono_plane_detection {
@@ -81,7 +83,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
                                       const std::optional<Pose>& odom_from_camera) {
   PipelineResult result;
   if (!history_.empty()) {
-    const double since = frame.stamp - history_.back().stamp;
+    const double since = frame.stamp - history_.back().frame.stamp;
     if (since < 0) {  // a bag looping: the map of the old run does not apply
       reset();
       result.was_reset = true;
@@ -95,30 +97,45 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
 
   if (pose_) result.pose = pose_->update(frame, odom_from_camera);
 
-  // Paper III compares consecutive images; at 30 images/s their parallax is tiny, so the
-  // reference is frame_gap images back (the tracks' ids give the correspondences).
+  // Paper III compares consecutive images; at 30 images/s their parallax is tiny. Until
+  // the camera is placed the reference is frame_gap images back; then it is the most
+  // recent image with enough rotation-free parallax (chooseReference).
+  std::vector<cv::Point2d> normalized;
+  const std::optional<Pose> pose =
+      result.pose ? std::optional<Pose>(result.pose->map_from_camera) : std::nullopt;
+  if (pose_) normalized = normalize(frame.pixels);
   if (!history_.empty()) {
-    const TrackFrame& reference =
-        history_.size() >= static_cast<size_t>(params_.frame_gap)
-            ? history_[history_.size() - static_cast<size_t>(params_.frame_gap)]
-            : history_.front();
-    result.reference_stamp = reference.stamp;
-    result.pairs = matchById(reference, frame);
-    if (result.pairs.ids.size() >= 5) {
-      result.segmentation = segmentPlanes(result.pairs.first, result.pairs.second, params_.planes);
-      for (const Plane& p : result.segmentation.planes) {
-        ImagePlane image_plane;
-        image_plane.H = p.H;
-        image_plane.rms_error_px = p.rms_error_px;
-        for (int i : p.inliers) image_plane.inlier_ids.push_back(result.pairs.ids[i]);
-        result.planes.push_back(std::move(image_plane));
+    const auto [index, parallax] = chooseReference(frame, pose, normalized);
+    result.parallax_px = parallax;
+    if (index < 0) {
+      result.pure_rotation = true;
+    } else {
+      const TrackFrame& reference = history_[static_cast<size_t>(index)].frame;
+      result.reference_stamp = reference.stamp;
+      result.pairs = matchById(reference, frame);
+      if (result.pairs.ids.size() >= 5) {
+        result.segmentation =
+            segmentPlanes(result.pairs.first, result.pairs.second, params_.planes);
+        for (const Plane& p : result.segmentation.planes) {
+          ImagePlane image_plane;
+          image_plane.H = p.H;
+          image_plane.rms_error_px = p.rms_error_px;
+          for (int i : p.inliers) image_plane.inlier_ids.push_back(result.pairs.ids[i]);
+          result.planes.push_back(std::move(image_plane));
+        }
       }
     }
   }
-  assignImageIds(result.planes);
+  // A rotation keeps the planes of the last image with parallax and their ids.
+  if (!result.pure_rotation) assignImageIds(result.planes);
 
   if (result.pose && pose_->scaleKnown()) {
     std::vector<PlaneObservation> observations;
+    // A landmark's position along its ray is uncertain by about depth x (angular noise)
+    // / parallax: the angular noise from this pose's reprojection error (both rays).
+    const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
+    const double angle_sigma = std::sqrt(2.0) * std::max(0.3, result.pose->rms_px) / focal;
+    const auto& landmarks = pose_->landmarks();
     for (const ImagePlane& p : result.planes) {
       PlaneObservation obs;
       obs.viewpoint = result.pose->map_from_camera.t;
@@ -126,6 +143,15 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
         if (const auto x = pose_->landmarkPosition(id)) {
           obs.ids.push_back(id);
           obs.points.push_back(*x);
+          const auto l = landmarks.find(id);
+          double sigma = params_.map.max_residual_m;
+          if (l != landmarks.end() && l->second.fixed) {
+            sigma = 0.001;
+          } else if (l != landmarks.end() && l->second.parallax_deg > 0) {
+            const double depth = cv::norm(*x - obs.viewpoint);
+            sigma = depth * angle_sigma / std::sin(l->second.parallax_deg * CV_PI / 180);
+          }
+          obs.sigma_m.push_back(sigma);
         }
       observations.push_back(std::move(obs));
     }
@@ -133,9 +159,9 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
 
-  history_.push_back(frame);
-  while (history_.size() > static_cast<size_t>(std::max(1, params_.frame_gap)))
-    history_.pop_front();
+  history_.push_back({frame, pose, std::move(normalized)});
+  const int keep = std::max({1, params_.frame_gap, params_.max_keyframe_age});
+  while (history_.size() > static_cast<size_t>(keep)) history_.pop_front();
 
   if (!pose_) {
     result.state = PipelineState::kNoCamera;
@@ -153,7 +179,101 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     result.state = PipelineState::kTracking;
     result.status = std::string("tracking (") + toString(result.pose->source) + ")";
   }
+  if (result.pure_rotation) {
+    std::ostringstream why;
+    why.precision(2);
+    why << std::fixed << "; too little parallax (" << result.parallax_px
+        << " px to every image within reach: nearly pure rotation or standing still): no "
+           "planes segmented";
+    result.status += why.str();
+  }
   return result;
+}
+
+std::vector<cv::Point2d> PlanePipeline::normalize(const std::vector<cv::Point2d>& pixels) const {
+  std::vector<cv::Point2d> out;
+  if (pixels.empty()) return out;
+  cv::undistortPoints(pixels, out, cv::Mat(K_), distortion_);
+  return out;
+}
+
+namespace {
+
+// The image motion a rotation cannot explain: the rotation that best maps the reference
+// rays onto the current ones (orthogonal Procrustes, twice, the second time without the
+// worst tracks), then the median distance left, in normalised image units. Depth
+// differences make it; a pure rotation leaves only noise, whatever the pose estimate.
+double rotationFreeParallax(const std::vector<cv::Vec3d>& a, const std::vector<cv::Vec3d>& b) {
+  std::vector<bool> use(a.size(), true);
+  double median = 0;
+  for (int round = 0; round < 2; ++round) {
+    cv::Matx33d M = cv::Matx33d::zeros();
+    for (size_t i = 0; i < a.size(); ++i)
+      if (use[i]) M += b[i] * a[i].t();
+    cv::Mat w, u, vt;
+    cv::SVD::compute(cv::Mat(M), w, u, vt);
+    cv::Mat R = u * vt;
+    if (cv::determinant(R) < 0) {
+      cv::Mat d = cv::Mat::eye(3, 3, CV_64F);
+      d.at<double>(2, 2) = -1;
+      R = u * d * vt;
+    }
+    const cv::Matx33d Rm = R;
+    std::vector<double> residual;
+    residual.reserve(a.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      const cv::Vec3d r = Rm * a[i];
+      residual.push_back(std::hypot(r[0] / r[2] - b[i][0] / b[i][2], r[1] / r[2] - b[i][1] / b[i][2]));
+    }
+    std::vector<double> sorted = residual;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    median = sorted[sorted.size() / 2];
+    for (size_t i = 0; i < a.size(); ++i) use[i] = residual[i] <= 3 * median + 1e-9;
+  }
+  return median;
+}
+
+}  // namespace
+
+std::pair<int, double> PlanePipeline::chooseReference(
+    const TrackFrame& frame, const std::optional<Pose>& /*pose*/,
+    const std::vector<cv::Point2d>& normalized) const {
+  const int n = static_cast<int>(history_.size());
+  const int fixed = std::max(0, n - std::max(1, params_.frame_gap));
+  if (!pose_ || n == 0 || normalized.size() != frame.ids.size()) return {fixed, -1.0};
+  std::unordered_map<std::uint64_t, size_t> current;
+  for (size_t i = 0; i < frame.ids.size(); ++i) current.emplace(frame.ids[i], i);
+  const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
+  int fallback = -1;
+  double fallback_parallax = -1;
+  // Newest first: the most recent image with enough parallax shares the most tracks.
+  for (int k = n - 1; k >= 0; --k) {
+    const PastFrame& past = history_[static_cast<size_t>(k)];
+    if (past.normalized.size() != past.frame.ids.size()) continue;
+    std::vector<cv::Vec3d> a, b;
+    for (size_t i = 0; i < past.frame.ids.size(); ++i) {
+      const auto it = current.find(past.frame.ids[i]);
+      if (it == current.end()) continue;
+      const cv::Point2d& p = past.normalized[i];
+      const cv::Point2d& q = normalized[it->second];
+      a.emplace_back(p.x, p.y, 1.0);
+      b.emplace_back(q.x, q.y, 1.0);
+    }
+    if (a.size() < 8 ||
+        static_cast<double>(a.size()) < params_.min_keyframe_shared * frame.ids.size())
+      continue;
+    const double parallax = focal * rotationFreeParallax(a, b);
+    if (parallax >= params_.keyframe_parallax_px) return {k, parallax};
+    if (parallax > fallback_parallax) {
+      fallback = k;
+      fallback_parallax = parallax;
+    }
+  }
+  if (fallback >= 0 && fallback_parallax >= params_.min_parallax_px)
+    return {fallback, fallback_parallax};
+  // No image within reach shares enough tracks (a jump): the fixed gap, as before.
+  if (fallback < 0) return {fixed, -1.0};
+  return {-1, std::max(0.0, fallback_parallax)};
 }
 
 void PlanePipeline::assignImageIds(std::vector<ImagePlane>& planes) {

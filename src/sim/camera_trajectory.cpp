@@ -39,7 +39,33 @@ cv::Matx33d cameraOrientation(double yaw, double pitch_down, double roll) {
   return {x[0], y[0], forward[0], x[1], y[1], forward[1], x[2], y[2], forward[2]};
 }
 
-Pose trajectoryPose(const TrajectoryParams& p, double t) {
+bool knownTrajectory(const std::string& name) {
+  return name == "wheeled" || name == "humanoid" || name == "rotation" ||
+         name == "turn_in_place" || name == "look_around";
+}
+
+Pose trajectoryPose(const TrajectoryParams& params, double t) {
+  TrajectoryParams p = params;
+  if (p.name == "turn_in_place") {
+    // On the spot: heading as the wheeled path's, no driving; the camera is ahead of the
+    // turning axis.
+    TrajectoryParams still = p;
+    still.speed_mps = 0;
+    double yaw;
+    cv::Vec3d position;
+    drive(still, t, yaw, position);
+    Pose pose;
+    pose.R = cameraOrientation(yaw, radians(p.pitch_down_deg), 0);
+    pose.t = cv::Vec3d(-std::sin(yaw), std::cos(yaw), 0) * p.camera_forward_m +
+             cv::Vec3d(0, 0, p.camera_height_m);
+    return pose;
+  }
+  double look = 0;
+  if (p.name == "look_around") {
+    look = radians(p.look_amplitude_deg) * std::sin(2 * CV_PI * t / p.look_period_s);
+    p.speed_mps /= 3;
+    p.name = "humanoid";
+  }
   const double pitch = radians(p.pitch_down_deg);
   Pose pose;
   if (p.name == "rotation") {
@@ -70,7 +96,7 @@ Pose trajectoryPose(const TrajectoryParams& p, double t) {
       extra_pitch += amplitude * std::exp(-since / 0.1);
     }
   }
-  pose.R = cameraOrientation(yaw, pitch + extra_pitch, roll);
+  pose.R = cameraOrientation(yaw + look, pitch + extra_pitch, roll);
   pose.t = position;
   return pose;
 }

@@ -89,6 +89,7 @@ cv::Mat SceneRenderer::renderFloat(const Pose& pose) const {
         const double a = local.dot(p.u_cam), b = local.dot(p.v_cam);
         const ScenePlane& sp = scene_.planes[k];
         if (a < 0 || b < 0 || a > sp.width_m || b > sp.height_m) continue;
+        if (!sp.holes.empty() && !sp.contains(a, b)) continue;
         best = s;
         hit = static_cast<int>(k);
         ha = a;

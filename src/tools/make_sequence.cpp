@@ -41,9 +41,11 @@ int main(int argc, char** argv) {
   std::string bag_path, yaml_path;
   bool quiet = false;
   unsigned seed = spec.room.seed;
+  std::string target = "sheet", textures;
   cli::Parser cli(
       "make_sequence", "[options] --out FILE.bag",
-      "  Renders a room (floor, walls, ceiling, the start-up target) seen from a moving camera\n"
+      "  Renders a room (floor, walls, ceiling, furniture with --layout furnished, the\n"
+      "  start-up target) seen from a moving camera\n"
       "  and writes a rosbag with /camera/image_raw, /camera/camera_info and /tf (map ->\n"
       "  camera_gt), plus the ground truth (planes, target, poses in the map frame) as\n"
       "  FILE.yaml next to it.",
@@ -53,7 +55,8 @@ int main(int argc, char** argv) {
   cli.text("out", &bag_path, "the bag to write (required)", "FILE.bag")
       .text("yaml", &yaml_path, "the ground truth to write (default: the bag's name, .yaml)",
             "FILE")
-      .choice("trajectory", &spec.trajectory.name, {"wheeled", "humanoid", "rotation"},
+      .choice("trajectory", &spec.trajectory.name,
+              {"wheeled", "humanoid", "rotation", "turn_in_place", "look_around"},
               "camera motion")
       .integer("frames", &spec.frames, 1, 100000, "images")
       .number("fps", &spec.fps, 0.1, 1000.0, "images per second (stamps 1/F apart)", "F")
@@ -75,13 +78,41 @@ int main(int argc, char** argv) {
       .number("exposure-swing", &spec.exposure_swing, 0.0, 0.99,
               "exposure varies by +-S, 4 s period", "S")
       .choice("encoding", &spec.encoding, {"mono8", "bgr8"}, "image encoding")
-      .choice("target", &spec.room.target_on, {"wall", "floor"}, "where the start-up target is")
+      .choice("target", &target, {"none", "sheet", "aruco", "wall", "floor"},
+              "the start-up target: none, a white sheet or an ArUco marker (wall, floor: a "
+              "sheet there, as before)")
+      .choice("target-on", &spec.room.target_on, {"wall", "floor", "table"},
+              "where the target is (table: --layout furnished)")
+      .choice("background", &spec.room.target_background, {"black", "grey", "wood"},
+              "around the sheet: a black border, a mid-grey wall, a wood-like table")
+      .integer("aruco-id", &spec.room.aruco_id, 0, 49, "the marker's id (DICT_4X4_50)")
+      .number("aruco-size", &spec.room.aruco_size_m, 0.03, 1.0,
+              "side of the marker's black square, m", "M")
+      .choice("layout", &spec.room.layout, {"bare", "furnished"},
+              "bare: floor, walls, ceiling; furnished: a sideboard, a bookshelf, a table and "
+              "a door recess, plain painted walls with posters next to textured ones")
+      .text("textures", &textures,
+            "paint the floor and walls (posters too) with the photographs in DIR", "DIR")
       .integer("walls", &spec.room.walls, 0, 4, "walls of the room")
       .flag("no-ceiling", &spec.room.ceiling, "a room without a ceiling", false)
       .flag("quiet", &quiet, "no progress and summary");
   if (const auto code = cli.parse(argc, argv)) return *code;
   if (bag_path.empty()) return cli.fail("--out FILE.bag is required");
   spec.room.seed = spec.trajectory.seed = seed;
+  if (target == "wall" || target == "floor") {  // the old meaning of --target
+    spec.room.target_on = target;
+    target = "sheet";
+  }
+  spec.room.target_type = target;
+  if (spec.room.target_on == "table" && spec.room.layout != "furnished")
+    return cli.fail("--target-on table needs --layout furnished (the bare room has no table)");
+  if (!textures.empty()) {
+    try {
+      spec.room.photos = loadTexturePhotos(textures);
+    } catch (const std::exception& e) {
+      return cli.fail(std::string("--textures: ") + e.what());
+    }
+  }
   spec.camera.fy = spec.camera.fx;
   const long long subpixels = static_cast<long long>(spec.camera.size.width) *
                               spec.camera.size.height * spec.render.supersample *

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <limits>
 #include <string>
 
@@ -16,6 +17,9 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "mono_plane_detection/sim/scene_renderer.h"
 #include "mono_plane_detection/tracking/target_startup.h"
+#include "mono_plane_detection/viz/draw_planes.h"
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 using namespace mono_plane_detection;
 
@@ -52,8 +56,15 @@ int main(int argc, char** argv) {
       "  Renders a room seen from a moving camera and runs tracker + planes + map on it,\n"
       "  then prints each mapped plane against the ground truth and the camera path error.",
       "exit codes: 0 every true plane mapped once, 1 a plane missed or split, 2 bad usage\n");
-  cli.choice("trajectory", &trajectory.name, {"wheeled", "humanoid", "rotation"},
-             "camera motion")
+  RoomParams room;
+  std::string textures, save_dir, top_view;
+  int save_every = 0;
+  cli.choice("trajectory", &trajectory.name,
+             {"wheeled", "humanoid", "rotation", "turn_in_place", "look_around"}, "camera motion")
+      .choice("layout", &room.layout, {"bare", "furnished"}, "the room (make_sequence --layout)")
+      .text("textures", &textures, "paint floor and walls with the photographs in DIR", "DIR")
+      .choice("background", &room.target_background, {"black", "grey", "wood"},
+              "around the start-up sheet")
       .integer("frames", &frames, 1, 1000000, "images per loop")
       .number("fps", &fps, 0.1, 1000.0, "images per second", "F")
       .number("noise", &render.noise_sigma, 0.0, 255.0, "image noise sigma, grey levels", "SIGMA")
@@ -64,10 +75,15 @@ int main(int argc, char** argv) {
             "humanoid), or a .yaml file over them; auto: the trajectory's profile",
             "P")
       .integer("frame-gap", &frame_gap, 0, 1000,
-               "frames between the two views of the planes (0: the profile's)")
+               "frames between the two views of the planes before the camera is placed (0: "
+               "the profile's)")
       .integer("width", &camera.size.width, 64, 4096, "image width, pixels", "W")
       .integer("height", &camera.size.height, 48, 4096, "image height, pixels", "H")
       .integer("features", &features, 0, 10000, "the tracker's max_features (0: the profile's)")
+      .text("save-dir", &save_dir, "write overlays (planes drawn) here, with --save-every", "DIR")
+      .integer("save-every", &save_every, 0, 1000000, "an overlay every N images (0: none)")
+      .text("top-view", &top_view,
+            "write a top view (room, furniture, confirmed planes, camera paths) as PNG", "FILE")
       .integer("report-every", &report_every, 0, 1000000,
                "print the state every N frames (0: only the end)")
       .integer("loop", &loops, 1, 100000,
@@ -80,15 +96,25 @@ int main(int argc, char** argv) {
   camera.cy = (camera.size.height - 1) / 2.0;
   trajectory.seed = seed;
 
-  RoomParams room;
   room.seed = seed;
+  if (!textures.empty()) {
+    try {
+      room.photos = loadTexturePhotos(textures);
+    } catch (const std::exception& e) {
+      return cli.fail(std::string("--textures: ") + e.what());
+    }
+  }
   const IndoorScene scene = makeRoom(room);
   const SceneRenderer renderer(scene, camera, render);
   std::vector<TruthPlane> truth = truthPlanes(scene);
+  std::vector<double> range(truth.size(), 1.0);
   const Pose map_from_world = scene.target.world_from_map.inverse();
 
   // The nodelets' settings for this robot, so that a run here is a run there.
-  if (profile == "auto") profile = trajectory.name == "rotation" ? "default" : trajectory.name;
+  if (profile == "auto")
+    profile = trajectory.name == "humanoid" || trajectory.name == "look_around" ? "humanoid"
+              : trajectory.name == "wheeled" || trajectory.name == "turn_in_place" ? "wheeled"
+                                                                                  : "default";
   TrackerNodeParams tracker_node;
   PlaneNodeParams plane_node;
   std::vector<std::string> errors =
@@ -109,7 +135,7 @@ int main(int argc, char** argv) {
               trajectory.name.c_str(), profile.c_str(), frames, loops, camera.size.width,
               camera.size.height, render.noise_sigma);
   FeatureTracker tracker(tracker_params);
-  TargetStartup startup;
+  TargetStartup startup(tracker_node.target);
   PlanePipeline pipeline(params);
   pipeline.setCamera(camera.K(), camera.distortion());
   const double start_rss = currentRssMb();
@@ -118,6 +144,7 @@ int main(int argc, char** argv) {
     tracker.reset();
     startup.reset();
     double track_ms = 0, plane_ms = 0, travelled = 0, pos_err_sum = 0, pos_err_max = 0;
+    std::vector<cv::Vec3d> path_truth, path_estimate;  // world frame
     int posed = 0, tracking = 0;
     cv::Vec3d last_position;
     for (int k = 0; k < frames; ++k) {
@@ -126,7 +153,13 @@ int main(int argc, char** argv) {
       if (loop == 0) {
         const std::vector<double> shares = imageShares(scene, camera, world_from_camera, 16);
         for (size_t p = 0; p < truth.size(); ++p)
-          truth[p].max_image_share = std::max(truth[p].max_image_share, shares[p]);
+          if (shares[p] > truth[p].max_image_share) {
+            truth[p].max_image_share = shares[p];
+            // Relative distance errors are judged against the camera's distance from
+            // the plane where it filled the image most.
+            range[p] = std::abs(scene.planes[p].normal().dot(world_from_camera.t) -
+                                scene.planes[p].distance());
+          }
       }
       const cv::Mat image = renderer.render(world_from_camera, seed * 100000u + k);
       const auto t0 = Clock::now();
@@ -146,6 +179,9 @@ int main(int argc, char** argv) {
       track_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
       plane_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
       const Pose truth_pose = map_from_world * world_from_camera;
+      path_truth.push_back(world_from_camera.t);
+      if (result.pose)
+        path_estimate.push_back(scene.target.world_from_map.apply(result.pose->map_from_camera.t));
       if (k > 0) travelled += cv::norm(truth_pose.t - last_position);
       last_position = truth_pose.t;
       double frame_err = -1;
@@ -157,6 +193,11 @@ int main(int argc, char** argv) {
         ++posed;
       }
       tracking += result.state == PipelineState::kTracking;
+      if (save_every > 0 && !save_dir.empty() && k % save_every == 0 && loop == 0) {
+        char name[64];
+        std::snprintf(name, sizeof(name), "/overlay_%04d.png", k);
+        cv::imwrite(save_dir + name, drawPlanes(image, result));
+      }
       if (report_every > 0 && (k + 1) % report_every == 0)
         std::printf(
             "  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
@@ -185,21 +226,79 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < confirmed.size(); ++i) {
       const MapPlane& p = confirmed[i];
       const PlaneMatch& m = eval.matches[i];
+      double relative = 0;
+      for (size_t t = 0; t < truth.size(); ++t)
+        if (truth[t].id == m.truth_id) relative = m.distance_error_m / range[t];
       std::printf(
           "  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
-          "(normal %.2f deg, distance %.3f m)\n",
+          "(normal %.2f deg, distance %.3f m = %.1f %%)\n",
           p.id, p.normal[0], p.normal[1], p.normal[2], p.distance, p.points.size(), p.observations,
           m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH", m.normal_error_deg,
-          m.distance_error_m);
+          m.distance_error_m, 100 * relative);
+      // What its points are: the true surface nearest to each (a mixture shows here).
+      std::map<std::string, int> made_of;
+      for (const auto& [id, entry] : p.points) {
+        const cv::Vec3d x = scene.target.world_from_map.apply(entry.first);
+        std::string best = "nothing";
+        double best_d = 0.05;
+        for (const ScenePlane& sp : scene.planes) {
+          const double dist = std::abs(sp.normal().dot(x) - sp.distance());
+          const cv::Vec3d local = x - sp.origin;
+          const double a = local.dot(sp.u_axis), b = local.dot(sp.v_axis);
+          if (a < -0.05 || b < -0.05 || a > sp.width_m + 0.05 || b > sp.height_m + 0.05) continue;
+          if (dist < best_d) {
+            best_d = dist;
+            best = sp.name;
+          }
+        }
+        ++made_of[best];
+      }
+      std::printf("    normal sigma %.2f deg, rms %.3f m; points on:", p.normal_sigma_deg, p.rms_m);
+      for (const auto& [name, count] : made_of) std::printf(" %s %d", name.c_str(), count);
+      std::printf("\n");
     }
     for (const TruthPlane& t : truth)
-      std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
-                  t.normal[0], t.normal[1], t.normal[2], t.distance, 100 * t.max_image_share);
+      if (t.max_image_share >= 0.02)
+        std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
+                    t.normal[0], t.normal[1], t.normal[2], t.distance, 100 * t.max_image_share);
+    int false_planes = 0;
+    for (const PlaneMatch& m : eval.matches) false_planes += m.truth_id < 0;
+    std::printf("false planes %d\n", false_planes);
     for (int id : eval.missed) std::printf("  missed: true plane %d\n", id);
     std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
                 eval.worst_distance_error_m);
     exit_code = eval.missed.empty() && eval.split.empty() ? 0 : 1;
+    if (!top_view.empty()) {
+      // Seen from above, world x to the right, y up the image, 80 px per metre.
+      const double scale = 80, x0 = -room.width_m / 2 - 0.3, y1 = room.front_m + 0.3;
+      cv::Mat view(static_cast<int>((room.front_m + room.back_m + 0.6) * scale),
+                   static_cast<int>((room.width_m + 0.6) * scale), CV_8UC3, cv::Scalar(255, 255, 255));
+      auto px = [&](const cv::Vec3d& x) {
+        return cv::Point(static_cast<int>((x[0] - x0) * scale), static_cast<int>((y1 - x[1]) * scale));
+      };
+      for (const ScenePlane& sp : scene.planes) {
+        if (sp.name == "ceiling") continue;
+        const auto c = sp.corners();
+        std::vector<cv::Point> poly;
+        for (const auto& v : c) poly.push_back(px(v));
+        if (std::abs(sp.normal()[2]) > 0.9) {
+          if (sp.name != "floor") cv::fillConvexPoly(view, poly, cv::Scalar(225, 225, 225));
+        } else {
+          cv::polylines(view, poly, true, cv::Scalar(0, 0, 0), 2);
+        }
+      }
+      for (const MapPlane& p : confirmed) {
+        std::vector<cv::Point> poly;
+        for (const auto& v : p.polygon) poly.push_back(px(scene.target.world_from_map.apply(v)));
+        if (poly.size() >= 2) cv::polylines(view, poly, true, planeColour(p.id), 2);
+      }
+      for (size_t k = 1; k < path_truth.size(); ++k)
+        cv::line(view, px(path_truth[k - 1]), px(path_truth[k]), cv::Scalar(120, 120, 120), 2);
+      for (size_t k = 1; k < path_estimate.size(); ++k)
+        cv::line(view, px(path_estimate[k - 1]), px(path_estimate[k]), cv::Scalar(0, 0, 255), 1);
+      cv::imwrite(top_view, view);
+    }
   }
   return exit_code;
 }

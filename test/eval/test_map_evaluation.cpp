@@ -63,3 +63,22 @@ TEST(MapEvaluation, MatchesMissesAndSplits) {
   EXPECT_EQ(e.missed, std::vector<int>{2});
   EXPECT_NEAR(e.worst_distance_error_m, 0.05, 1e-9);
 }
+
+// A wall and the door recessed 0.12 m in it have the same normal: a mapped plane goes to
+// the one it is nearer to, not to whichever comes last.
+TEST(MapEvaluation, ParallelSurfacesAreToldApartByOffset) {
+  std::vector<TruthPlane> truth(2);
+  truth[0] = {1, "left_wall", {1, 0, 0}, -3.0, 0.5};
+  truth[1] = {2, "door", {1, 0, 0}, -3.12, 0.05};
+  std::vector<MapPlane> planes(2);
+  planes[0].id = 1;
+  planes[0].normal = {1, 0, 0};
+  planes[0].distance = -3.01;
+  planes[1].id = 2;
+  planes[1].normal = {1, 0, 0};
+  planes[1].distance = -3.11;
+  const MapEvaluation e = evaluateMap(planes, truth);
+  EXPECT_EQ(e.matches[0].truth_id, 1);
+  EXPECT_EQ(e.matches[1].truth_id, 2);
+  EXPECT_TRUE(e.split.empty());
+}

@@ -141,3 +141,63 @@ TEST(PlanePipeline, RecalibrationWithAnotherNumberOfCoefficientsRestarts) {
   }
   EXPECT_TRUE(pipeline.hasCamera());
 }
+
+// Issue 18: the image to compare with is chosen by its rotation-free parallax. A robot
+// that stops and turns on the spot: while older images within reach still have
+// parallax they are used; once every image within reach is a rotation away, the status
+// says so and nothing is segmented (every plane would move with one homography).
+TEST(PlanePipeline, PureRotationIsReportedAndNotSegmented) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k <= 60; ++k) r = pipeline.process(world.frame(k / 30.0));
+  ASSERT_EQ(r.state, PipelineState::kTracking);
+  EXPECT_FALSE(r.pure_rotation);
+  EXPECT_GE(r.parallax_px, pipeline.params().keyframe_parallax_px);
+  // Then it turns left on the spot, 0.5 deg per image.
+  const Pose stop = trajectoryPose(world.trajectory, 2.0);
+  int segmented_early = 0, rotation_late = 0;
+  for (int k = 1; k <= 80; ++k) {
+    const double yaw = 0.5 * k * CV_PI / 180;
+    const cv::Matx33d turn(std::cos(yaw), -std::sin(yaw), 0, std::sin(yaw), std::cos(yaw), 0, 0,
+                           0, 1);
+    const Pose pose{turn * stop.R, stop.t};
+    r = pipeline.process(world.frameAt(pose, 1002.0 + k / 30.0));
+    if (k <= 10 && !r.planes.empty() && r.parallax_px >= pipeline.params().min_parallax_px)
+      ++segmented_early;
+    if (k > 60) {
+      ASSERT_TRUE(r.pose) << k;
+      rotation_late += r.pure_rotation;
+      if (r.pure_rotation) {
+        EXPECT_TRUE(r.planes.empty());
+        EXPECT_NE(r.status.find("pure rotation"), std::string::npos) << r.status;
+        EXPECT_NE(r.status.find("no planes segmented"), std::string::npos) << r.status;
+        EXPECT_LT(r.parallax_px, pipeline.params().min_parallax_px);
+      }
+    }
+  }
+  EXPECT_GE(segmented_early, 8);  // the images from before the stop still have parallax
+  EXPECT_EQ(rotation_late, 20);
+}
+
+// Slow motion: a fixed gap of 5 images would hold 1.7 cm of motion; the keyframe is
+// taken further back, where the parallax is.
+TEST(PlanePipeline, SlowMotionComparesWithAnOlderKeyframe) {
+  SyntheticTracks world("wheeled");
+  world.trajectory.speed_mps = 0.1;
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  int measured = 0, far_back = 0;
+  for (int k = 0; k < 200; ++k) {
+    const TrackFrame f = world.frame(k / 30.0);
+    const PipelineResult r = pipeline.process(f);
+    if (r.parallax_px < 0 || r.pure_rotation) continue;
+    ++measured;
+    EXPECT_GE(r.parallax_px, pipeline.params().min_parallax_px);
+    far_back += f.stamp - r.reference_stamp > 5.5 / 30.0;
+  }
+  EXPECT_GE(measured, 100);
+  EXPECT_GE(far_back, measured * 9 / 10);
+}
+

@@ -68,6 +68,38 @@ TEST(CameraTrajectory, RotationStaysInPlace) {
   EXPECT_NEAR(degrees(max_yaw), p.rotation_amplitude_deg, 0.5);
 }
 
+// Issue 18: paths that turn a lot while moving little, where every plane moves with
+// nearly the same homography over a few images.
+TEST(CameraTrajectory, TurnInPlaceAndLookAroundTurnALotAndMoveLittle) {
+  for (const std::string name : {"turn_in_place", "look_around"}) {
+    TrajectoryParams p;
+    p.name = name;
+    ASSERT_TRUE(knownTrajectory(name));
+    double path = 0, turned = 0;
+    Pose last = trajectoryPose(p, 0);
+    for (int k = 1; k <= 300; ++k) {
+      const Pose pose = trajectoryPose(p, k / 30.0);
+      path += cv::norm(pose.t - last.t);
+      const cv::Matx33d dR = last.R.t() * pose.R;
+      turned += degrees(std::acos(std::min(1.0, (cv::trace(dR) - 1) / 2)));
+      // Orthonormal, optical axis never up.
+      EXPECT_LT(cv::norm(pose.R.t() * pose.R - cv::Matx33d::eye()), 1e-9);
+      last = pose;
+    }
+    if (name == "turn_in_place") {
+      // 150 deg about a vertical axis 0.15 m behind the camera: an arc of 0.39 m.
+      EXPECT_NEAR(path, 0.15 * 150 * CV_PI / 180, 0.01);
+      EXPECT_NEAR(turned, 150 * std::cos(10 * CV_PI / 180), 150 * 0.05);
+    } else {
+      EXPECT_LT(path, 2.2);    // a third of the wheeled speed (1 m), plus the step bob
+      EXPECT_GT(turned, 250);  // head swings of +- 35 deg every 4 s on top of the 150 deg
+    }
+    EXPECT_GT(turned / path, 120) << name;  // degrees per metre; the wheeled path: 50
+    std::printf("%s: turned %.0f deg over %.2f m\n", name.c_str(), turned, path);
+  }
+  EXPECT_FALSE(knownTrajectory("flying"));
+}
+
 TEST(CameraModel, ProjectsWithAndWithoutDistortion) {
   CameraModel cam;
   const cv::Point2d centre = cam.project({0, 0, 2});

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+#include <set>
+
 #include "mono_plane_detection/sim/indoor_scene.h"
 
 using namespace mono_plane_detection;
@@ -83,4 +86,150 @@ TEST(IndoorScene, PoseAlgebra) {
   EXPECT_LT(cv::norm(a.inverse().apply(a.apply(x)) - x), 1e-12);
   EXPECT_LT(cv::norm((a * a.inverse()).apply(x) - x), 1e-12);
   EXPECT_LT(cv::norm(a.apply(x) - cv::Vec3d(3, 2.5, 10)), 1e-12);
+}
+
+// ---- The furnished room (issue 18) --------------------------------------------------
+
+namespace {
+
+const std::string kTextures = std::string(TEST_DATA_DIR) + "/textures";
+
+const ScenePlane* planeNamed(const IndoorScene& scene, const std::string& name) {
+  for (const auto& p : scene.planes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+// Mean absolute Sobel response: how much a corner detector has to hold on to.
+double gradientEnergy(const cv::Mat& texture) {
+  cv::Mat gx, gy;
+  cv::Sobel(texture, gx, CV_32F, 1, 0);
+  cv::Sobel(texture, gy, CV_32F, 0, 1);
+  return cv::mean(cv::abs(gx))[0] + cv::mean(cv::abs(gy))[0];
+}
+
+}  // namespace
+
+TEST(FurnishedRoom, FurnitureFacesAreBoundedPlanesFacingOutOfTheirBoxes) {
+  RoomParams params;
+  params.layout = "furnished";
+  const IndoorScene scene = makeRoom(params);
+  for (const std::string name :
+       {"sideboard_-y", "sideboard_+z", "sideboard_-x", "shelf_+x", "shelf_+y", "shelf_-y",
+        "table_+z", "table_-z", "door", "door_jamb_near", "door_jamb_far", "door_lintel"})
+    ASSERT_NE(planeNamed(scene, name), nullptr) << name;
+  // Unit normals, every corner on its plane, ids unique.
+  std::set<int> ids;
+  for (const auto& p : scene.planes) {
+    EXPECT_NEAR(cv::norm(p.normal()), 1.0, 1e-12) << p.name;
+    for (const auto& c : p.corners()) EXPECT_NEAR(p.normal().dot(c), p.distance(), 1e-12);
+    EXPECT_TRUE(ids.insert(p.id).second) << p.name;
+  }
+  // Out of the box: the sideboard's front faces the start, its top faces up, the
+  // shelf's front faces into the room (+x), the table's underside faces down.
+  EXPECT_NEAR(planeNamed(scene, "sideboard_-y")->normal()[1], -1, 1e-12);
+  EXPECT_NEAR(planeNamed(scene, "sideboard_+z")->normal()[2], 1, 1e-12);
+  EXPECT_NEAR(planeNamed(scene, "shelf_+x")->normal()[0], 1, 1e-12);
+  EXPECT_NEAR(planeNamed(scene, "table_-z")->normal()[2], -1, 1e-12);
+  // From the start, straight ahead at 0.4 m height, 1 m to the right: the sideboard's
+  // front, 0.45 m before the front wall.
+  RayHit hit = castRay(scene, {1.0, 0, 0.4}, {0, 1, 0});
+  ASSERT_GE(hit.plane, 0);
+  EXPECT_EQ(scene.planes[hit.plane].name, "sideboard_-y");
+  EXPECT_NEAR(hit.distance, params.front_m - 0.45, 1e-12);
+  // Towards the left wall through the door opening: the door, recessed 0.12 m.
+  hit = castRay(scene, {0, -2.1, 1.0}, {-1, 0, 0});
+  ASSERT_GE(hit.plane, 0);
+  EXPECT_EQ(scene.planes[hit.plane].name, "door");
+  EXPECT_NEAR(hit.distance, params.width_m / 2 + 0.12, 1e-12);
+  // Beside the door: the wall itself.
+  hit = castRay(scene, {0, -1.0, 1.0}, {-1, 0, 0});
+  EXPECT_EQ(scene.planes[hit.plane].name, "left_wall");
+  // Table top from above, the floor under it seen from below the top.
+  hit = castRay(scene, {-1.1, -1.8, 1.5}, {0, 0, -1});
+  EXPECT_EQ(scene.planes[hit.plane].name, "table_+z");
+  EXPECT_NEAR(hit.distance, 1.5 - 0.74, 1e-12);
+  EXPECT_EQ(scene.planes[castRay(scene, {-1.1, -1.8, 0.5}, {0, 0, -1}).plane].name, "floor");
+}
+
+TEST(FurnishedRoom, PlainPaintNextToRichTextureAndPhotographs) {
+  RoomParams params;
+  params.layout = "furnished";
+  const IndoorScene generated = makeRoom(params);
+  // Weak: painted walls are smooth away from their posters; rich: the sideboard front.
+  const ScenePlane& back = *planeNamed(generated, "back_wall");
+  EXPECT_EQ(back.surface, "paint");
+  const cv::Mat bare_paint = back.texture(cv::Rect(0, 0, 150, 150));  // floor level, no poster
+  EXPECT_LT(gradientEnergy(bare_paint), 1.0);
+  EXPECT_GT(gradientEnergy(planeNamed(generated, "sideboard_-y")->texture), 20.0);
+  EXPECT_EQ(planeNamed(generated, "shelf_+x")->surface, "books");
+  EXPECT_EQ(planeNamed(generated, "table_+z")->surface, "wood");
+  // The posters: corners on a painted wall.
+  EXPECT_GT(gradientEnergy(planeNamed(generated, "right_wall")->texture), 2 * gradientEnergy(bare_paint));
+
+  params.photos = loadTexturePhotos(kTextures);
+  ASSERT_EQ(params.photos.size(), 3u);  // test/data/textures/README.md
+  const IndoorScene photographed = makeRoom(params);
+  for (const std::string name : {"floor", "front_wall", "left_wall"}) {
+    const ScenePlane& p = *planeNamed(photographed, name);
+    EXPECT_EQ(p.surface, "photo") << name;
+    EXPECT_GT(gradientEnergy(p.texture), 5.0) << name;
+    // Not the generated texture: the photograph's pixels.
+    EXPECT_GT(cv::norm(p.texture, planeNamed(generated, name)->texture, cv::NORM_L1) / p.texture.total(),
+              10.0)
+        << name;
+  }
+  EXPECT_THROW(loadTexturePhotos(std::string(TEST_DATA_DIR) + "/no_such_folder"),
+               std::runtime_error);
+  RoomParams bad;
+  bad.layout = "castle";
+  EXPECT_THROW(makeRoom(bad), std::invalid_argument);
+}
+
+TEST(StartTargets, NoneLeavesTheWallAsItIsAndKeepsTheMapFrame) {
+  RoomParams with, without;
+  without.target_type = "none";
+  const IndoorScene a = makeRoom(with), b = makeRoom(without);
+  EXPECT_EQ(b.target.type, "none");
+  EXPECT_LT(cv::norm(a.target.centre - b.target.centre), 1e-12);
+  const ScenePlane& wall = b.planes[b.target.plane_index];
+  const cv::Vec3d local = b.target.centre - wall.origin;
+  const int col = static_cast<int>(local.dot(wall.u_axis) * wall.texels_per_m),
+            row = static_cast<int>(local.dot(wall.v_axis) * wall.texels_per_m);
+  // The generated texture there: no white sheet, no black border.
+  const cv::Mat around = wall.texture(cv::Rect(col - 40, row - 30, 80, 60));
+  double lo, hi;
+  cv::minMaxLoc(around, &lo, &hi);
+  EXPECT_LT(hi, 255);
+  EXPECT_EQ(cv::countNonZero(around < 3), 0);
+}
+
+TEST(StartTargets, SheetOnGreyWallOrWoodTable) {
+  for (const std::string background : {"grey", "wood"}) {
+    RoomParams params;
+    params.layout = "furnished";
+    params.target_background = background;
+    if (background == "wood") params.target_on = "table";
+    const IndoorScene scene = makeRoom(params);
+    const StartTarget& t = scene.target;
+    const ScenePlane& plane = scene.planes[t.plane_index];
+    EXPECT_EQ(plane.name, background == "wood" ? "table_+z" : "front_wall");
+    EXPECT_NEAR(cv::norm(t.corners[1] - t.corners[0]), 0.297, 1e-12);
+    auto texel = [&](const cv::Vec3d& x) {
+      const cv::Vec3d local = x - plane.origin;
+      return static_cast<int>(plane.texture.at<uchar>(
+          static_cast<int>(std::lround(local.dot(plane.v_axis) * plane.texels_per_m)),
+          static_cast<int>(std::lround(local.dot(plane.u_axis) * plane.texels_per_m))));
+    };
+    EXPECT_EQ(texel(t.centre), 255);
+    // Just outside the sheet: mid-grey, or wood (neither black nor white).
+    const cv::Vec3d outside = t.corners[0] + 0.2 * (t.corners[0] - t.centre);
+    if (background == "grey")
+      EXPECT_EQ(texel(outside), 128);
+    else
+      EXPECT_TRUE(texel(outside) > 60 && texel(outside) < 180) << texel(outside);
+  }
+  RoomParams bare_table;
+  bare_table.target_on = "table";
+  EXPECT_THROW(makeRoom(bare_table), std::invalid_argument);
 }

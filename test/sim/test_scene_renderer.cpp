@@ -1,6 +1,7 @@
 // The renderer against the geometry: rays, depths, pixels and plane-induced motion.
 #include <gtest/gtest.h>
 
+#include <opencv2/aruco.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -183,4 +184,37 @@ TEST(SceneRenderer, SameSeedSameImageAndNoiseBlurExposureWork) {
   dark.exposure = 0.5;
   const cv::Mat half = SceneRenderer(f.scene, f.camera, dark).render(pose);
   EXPECT_NEAR(cv::mean(half)[0], cv::mean(one)[0] / 2, 1.0);
+}
+
+// The ArUco target (issue 12 part 4): OpenCV's own detector finds the rendered marker
+// with its id, and its corners where the ground truth projects them.
+TEST(SceneRenderer, ArucoMarkerIsFoundWhereItsCornersAre) {
+  RoomParams room;
+  room.target_type = "aruco";
+  room.aruco_id = 7;
+  const IndoorScene scene = makeRoom(room);
+  ASSERT_EQ(scene.target.type, "aruco");
+  EXPECT_NEAR(scene.target.width_m, 0.15, 0.01);
+  const CameraModel camera;
+  const SceneRenderer renderer(scene, camera, RenderOptions());
+  TrajectoryParams trajectory;
+  for (double t : {0.0, 1.0}) {
+    const Pose world_from_camera = trajectoryPose(trajectory, t);
+    const cv::Mat image = renderer.render(world_from_camera);
+    std::vector<std::vector<cv::Point2f>> corners;
+    std::vector<int> ids;
+    // The pre-4.7 API (Noetic's OpenCV 4.2 has no ArucoDetector).
+    const cv::Ptr<cv::aruco::DetectorParameters> detector = cv::aruco::DetectorParameters::create();
+    detector->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+    cv::aruco::detectMarkers(image, cv::aruco::getPredefinedDictionary(cv::aruco::DICT_4X4_50),
+                             corners, ids, detector);
+    ASSERT_EQ(ids.size(), 1u) << "t = " << t;
+    EXPECT_EQ(ids[0], 7);
+    // OpenCV's order (top-left, top-right, bottom-right, bottom-left) is ours 3, 2, 1, 0.
+    const Pose camera_from_world = world_from_camera.inverse();
+    for (int k = 0; k < 4; ++k) {
+      const cv::Point2d truth = camera.project(camera_from_world.apply(scene.target.corners[3 - k]));
+      EXPECT_LT(cv::norm(cv::Point2d(corners[0][k]) - truth), 0.25) << "corner " << k;
+    }
+  }
 }

@@ -43,12 +43,18 @@ struct SyntheticTracks {
 
   // The frame at time t (s); stamps start at 1000 s.
   TrackFrame frame(double t, double noise_px = 0.2, unsigned seed = 7) const {
-    const Pose world_from_camera = trajectoryPose(trajectory, t);
+    return frameAt(trajectoryPose(trajectory, t), 1000 + t, noise_px, seed);
+  }
+
+  // The frame seen from any camera pose (world_from_camera), stamped `stamp`.
+  TrackFrame frameAt(const Pose& world_from_camera, double stamp, double noise_px = 0.2,
+                     unsigned seed = 7) const {
+    const double t = stamp - 1000;
     const Pose camera_from_world = world_from_camera.inverse();
     std::mt19937 rng(seed + static_cast<unsigned>(t * 1000));
     std::normal_distribution<double> noise(0.0, noise_px);
     TrackFrame f;
-    f.stamp = 1000 + t;
+    f.stamp = stamp;
     f.size = camera.size;
     auto add = [&](std::uint64_t id, const cv::Vec3d& x, bool corner) {
       const cv::Vec3d c = camera_from_world.apply(x);

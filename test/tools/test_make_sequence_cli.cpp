@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
+#include <vector>
 
 #include "support/run_program.h"
 
@@ -86,4 +88,42 @@ TEST(MakeSequenceCli, UnwritableYamlExitsOne) {
                                   temp("ok.bag") + " --yaml /no/such/folder/x.yaml");
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("cannot write"), std::string::npos);
+}
+
+// Issue 12 part 4 and issue 18: the target, its background, the furnished room and real
+// photographs as textures, each written into a bag and its ground truth.
+TEST(MakeSequenceCli, TargetsBackgroundsLayoutAndTextures) {
+  const std::string textures = std::string(TEST_DATA_DIR) + "/textures";
+  struct Case {
+    std::string args, yaml_has;
+  };
+  const std::vector<Case> cases = {
+      {"--target none", "type: none"},
+      {"--target aruco --aruco-id 3", "aruco_id: 3"},
+      {"--target sheet --background grey", "background: grey"},
+      {"--target sheet --background wood --layout furnished --target-on table", "table_+z"},
+      {"--layout furnished --textures " + textures, "surface: photo"},
+      {"--layout furnished --trajectory turn_in_place", "shelf_+x"},
+      {"--trajectory look_around", "look_around"},
+  };
+  int n = 0;
+  for (const Case& c : cases) {
+    const std::string bag = temp("options_" + std::to_string(n++) + ".bag");
+    const ProgramRun r =
+        runBounded("--frames 2 --width 80 --height 60 --focal 66 --quiet " + c.args + " --out " + bag);
+    ASSERT_EQ(r.code, 0) << c.args << ": " << r.err;
+    std::ifstream yaml(bag.substr(0, bag.size() - 4) + ".yaml");
+    const std::string text((std::istreambuf_iterator<char>(yaml)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(c.yaml_has), std::string::npos) << c.args;
+  }
+  // Bad usage: a table in the bare room, a folder without images, unknown values.
+  for (const std::string bad :
+       {std::string("--target-on table"), std::string("--textures /no/such/folder"),
+        std::string("--target poster"), std::string("--background pink"),
+        std::string("--layout castle"), std::string("--aruco-id 50")}) {
+    const ProgramRun r = runBounded("--frames 2 --width 80 --height 60 --quiet " + bad + " --out " +
+                                    temp("bad_option.bag"));
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_FALSE(r.err.empty()) << bad;
+  }
 }

@@ -44,8 +44,8 @@ struct MapEvaluation {
   double worst_normal_error_deg = 0, worst_distance_error_m = 0;
 };
 
-// Matches each mapped plane to the true plane with the closest normal among those within
-// the gates. Required: true planes with max_image_share >= min_share.
+// Matches each mapped plane to the true plane within the gates with the least
+// angle / max_angle_deg + offset / max_offset_m. Required: true planes with max_image_share >= min_share.
 MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector<TruthPlane>& truth,
                           double min_share = 0.10, double max_angle_deg = 20.0,
                           double max_offset_m = 0.3);

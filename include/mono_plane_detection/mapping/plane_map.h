@@ -8,6 +8,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "mono_plane_detection/geometry/plane_fit.h"
+
 namespace mono_plane_detection {
 
 struct MapParams {
@@ -19,6 +21,23 @@ struct MapParams {
   double max_offset_m = 0.15;         // association / merge gate on the distance between planes
   double min_shared_ids = 0.3;        // or: this share of the observation's tracks already on it
   int confirm_observations = 3;       // a plane is confirmed after this many observations
+  // An observation counts only from a viewpoint at least this share of the plane's
+  // distance away from every view counted before (3 images of one spot do not confirm).
+  double view_spacing = 0.03;
+  // A point is on a plane within this many standard deviations of its position along
+  // the viewing ray (PlaneObservation::sigma_m), never beyond max_residual_m.
+  double coplanar_sigmas = 3.0;
+  double min_residual_m = 0.005;      // the tolerance of a perfectly triangulated point
+  // Points known less well than this across the plane (their uncertainty along the ray
+  // times the ray's angle to the plane) cannot test coplanarity: they wait outside the
+  // map until retriangulated with more parallax.
+  double max_point_sigma_m = 0.05;  // = max_residual_m: 0.02-0.03 lost far walls (measured)
+  // A plane whose points fall into two groups this far apart, one of which alone is not
+  // that plane (or only a strip), is two surfaces: not taken.
+  double min_gap_m = 0.25;
+  // And only once its points fix its normal to this (1 sigma, normal_sigma_deg): half the
+  // 2 deg a mapped plane may be off. A strip of points leaves the plane free to turn.
+  double max_normal_sigma_deg = 1.0;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -30,6 +49,10 @@ struct PlaneObservation {
   std::vector<std::uint64_t> ids;  // tracks on the plane with a 3D position
   std::vector<cv::Vec3d> points;   // their positions, map frame, m
   cv::Vec3d viewpoint;             // camera centre, map frame (orients the normal)
+  // Per point: standard deviation of its position along the viewing ray (m), from the
+  // landmark's parallax and the pose's reprojection error. Empty: unknown, every point
+  // gets max_residual_m.
+  std::vector<double> sigma_m;
 };
 
 struct MapPlane {
@@ -37,13 +60,19 @@ struct MapPlane {
   cv::Vec3d normal{0, 0, 1};       // unit, towards the side it was seen from
   double distance = 0;             // m: the plane is {x : normal . x = distance}
   double rms_m = 0;                // fit over its points
+  // How well its points fix the normal (deg): rms / sqrt(points) against their spread
+  // across the plane's long axis.
+  double normal_sigma_deg = 180;
   std::vector<cv::Vec3d> polygon;  // convex hull of its points, map frame
-  int observations = 0;
+  int observations = 0;               // from distinct viewpoints (MapParams::view_spacing)
+  std::vector<cv::Vec3d> views;      // the viewpoints counted, map frame
   double first_seen = 0, last_seen = 0;  // stamps, s
   double confidence = 0;                 // 0..1: grows with observations, fades unseen
   // Track id -> latest position and the stamp it was seen on the plane.
   std::map<std::uint64_t, std::pair<cv::Vec3d, double>> points;
-  bool confirmed(const MapParams& p) const { return observations >= p.confirm_observations; }
+  bool confirmed(const MapParams& p) const {
+    return observations >= p.confirm_observations && normal_sigma_deg <= p.max_normal_sigma_deg;
+  }
 };
 
 class PlaneMap {
@@ -61,6 +90,11 @@ class PlaneMap {
   void reset();
 
  private:
+  // Each point's tolerance from the plane with this normal (coplanar_sigmas x its
+  // uncertainty across the plane, within [min_residual_m, max_residual_m]); -1 for a
+  // point too uncertain across it (max_point_sigma_m).
+  std::vector<double> tolerances(const PlaneObservation& obs, const cv::Vec3d& normal) const;
+  PlaneFit fitObservation(const PlaneObservation& obs, int needed) const;
   int fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance, double stamp);
   int associate(const cv::Vec3d& normal, double distance, const PlaneObservation& obs) const;
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint) const;

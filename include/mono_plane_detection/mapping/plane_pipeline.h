@@ -23,8 +23,19 @@ struct PipelineParams {
   PoseParams pose;
   MapParams map;
   TargetParams target;
-  int frame_gap = 5;       // compare each image with the one this many images before
+  // Without intrinsics (or no image sharing enough tracks): compare with the image this
+  // many images before.
+  int frame_gap = 5;
   double max_gap_s = 1.0;  // a longer pause between images is a tracking loss
+  // With intrinsics, the image to compare with (a keyframe) is chosen by its parallax:
+  // the median image motion of the tracks that the best-fitting rotation between the two
+  // images leaves (pixels at the focal length). Under rotation alone every plane moves
+  // with the same homography and the planes cannot be told apart. Without intrinsics:
+  // frame_gap images back.
+  double keyframe_parallax_px = 12.0;  // the most recent image with this much is taken
+  double min_parallax_px = 4.0;        // below this (the best within reach): no planes
+  int max_keyframe_age = 45;           // images kept to choose from (1.5 s at 30 Hz)
+  double min_keyframe_shared = 0.5;    // of the current tracks the keyframe must still hold
 };
 
 // Empty when K and the distortion describe a usable camera, else why not.
@@ -49,6 +60,12 @@ struct PipelineResult {
   std::optional<PoseEstimate> pose;  // this image's camera in the map
   std::vector<ImagePlane> planes;    // largest first
   double reference_stamp = -1;       // image the homographies start from, -1 none
+  // Rotation-free parallax to the reference (px at the focal length), -1 when not
+  // measured (no intrinsics: the reference is frame_gap images back).
+  double parallax_px = -1;
+  // The motion since the images within reach is (nearly) a pure rotation: no planes
+  // were segmented (status says so).
+  bool pure_rotation = false;
   TrackPairs pairs;             // reference/current pixels the planes were found in
   PlaneSegmentation segmentation;    // over `pairs`
 };
@@ -82,7 +99,19 @@ class PlanePipeline {
   cv::Matx33d K_;
   cv::Mat distortion_;
   PlaneMap map_;
-  std::deque<TrackFrame> history_;
+  struct PastFrame {
+    TrackFrame frame;
+    std::optional<Pose> map_from_camera;
+    std::vector<cv::Point2d> normalized;  // undistorted, per track (with intrinsics)
+  };
+  // The reference for `frame`: index into history_, its parallax (-1: not measured),
+  // -1 index when every image within reach is a rotation away.
+  std::pair<int, double> chooseReference(const TrackFrame& frame,
+                                         const std::optional<Pose>& pose,
+                                         const std::vector<cv::Point2d>& normalized) const;
+  std::vector<cv::Point2d> normalize(const std::vector<cv::Point2d>& pixels) const;
+
+  std::deque<PastFrame> history_;
   std::vector<ImagePlane> previous_planes_;
   int next_image_id_ = 1;
 };

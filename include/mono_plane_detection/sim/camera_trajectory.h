@@ -1,6 +1,8 @@
 // The camera of a synthetic sequence and how it moves: a pinhole with optional radial
 // distortion, and the paths of a wheeled robot, a walking (humanoid) robot and a pure
-// rotation in place (the paper's hard case). ROS-free.
+// rotation in place (the paper's hard case), and two that turn a lot while moving little:
+// a wheeled robot turning on the spot and a humanoid looking around as it walks slowly.
+// ROS-free.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -12,7 +14,8 @@
 namespace mono_plane_detection {
 
 struct TrajectoryParams {
-  std::string name = "wheeled";        // wheeled | humanoid | rotation
+  // wheeled | humanoid | rotation | turn_in_place | look_around
+  std::string name = "wheeled";
   double speed_mps = 0.3;              // forward speed (wheeled, humanoid)
   double turn_deg = 150;               // total left turn over the sequence (wheeled, humanoid)
   double duration_s = 10;              // the turn is spread over this time
@@ -20,7 +23,17 @@ struct TrajectoryParams {
   double pitch_down_deg = 10;          // camera tilt towards the floor
   double rotation_amplitude_deg = 60;  // rotation: yaw swings +- this, in place
   unsigned seed = 1;                   // humanoid jerks
+  // turn_in_place: the robot turns by turn_deg on the spot; the camera sits this far
+  // ahead of the turning axis, so it moves on a small arc (0.39 m for 150 deg).
+  double camera_forward_m = 0.15;
+  // look_around: a humanoid walking at a third of speed_mps whose head swings its yaw
+  // by +- this with this period.
+  double look_amplitude_deg = 35;
+  double look_period_s = 4;
 };
+
+// The names trajectoryPose knows.
+bool knownTrajectory(const std::string& name);
 
 // world_from_camera at time t (s) with t = 0 the start: in front of the target, looking
 // along +y. Smooth in t except for the humanoid's jerks.

@@ -52,9 +52,10 @@ void validate(const SequenceSpec& spec) {
       !(spec.camera.fy > 0))
     throw SequenceSpecError("camera size and focal lengths must be positive");
   const std::string& name = spec.trajectory.name;
-  if (name != "wheeled" && name != "humanoid" && name != "rotation")
-    throw SequenceSpecError("trajectory must be wheeled, humanoid or rotation, not '" + name +
-                             "'");
+  if (!knownTrajectory(name))
+    throw SequenceSpecError(
+        "trajectory must be wheeled, humanoid, rotation, turn_in_place or look_around, not '" +
+        name + "'");
 }
 
 void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const std::string& path) {
@@ -80,6 +81,16 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
       "origin at the target centre; x along the target's width, y along its "
       "height, z = x cross y out of the target into the room (metres)";
   YAML::Node target;
+  root["layout"] = spec.room.layout;
+  target["type"] = scene.target.type;
+  if (scene.target.type == "aruco") {
+    target["aruco_dictionary"] = scene.target.aruco_dictionary;
+    target["aruco_id"] = scene.target.aruco_id;
+    target["corner_order"] =
+        "corners_map: (-x,-y) (+x,-y) (+x,+y) (-x,+y); the marker's top-left, top-right, "
+        "bottom-right, bottom-left are corners 3, 2, 1, 0";
+  }
+  target["background"] = scene.target.type == "sheet" ? spec.room.target_background : "";
   target["width_m"] = scene.target.width_m;
   target["height_m"] = scene.target.height_m;
   target["plane_id"] = scene.planes[scene.target.plane_index].id;
@@ -100,6 +111,7 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
     plane["max_image_share"] = max_share[i];
     plane["id"] = p.id;
     plane["name"] = p.name;
+    plane["surface"] = p.surface;
     const cv::Vec3d n = map_from_world.R * p.normal();
     plane["normal"] = vec(n);
     plane["distance_m"] = n.dot(map_from_world.apply(p.origin));
@@ -132,7 +144,12 @@ SequenceReport writeSequence(const SequenceSpec& spec, const std::string& bag_pa
                              const std::string& yaml_path,
                              const std::function<void(int)>& progress) {
   validate(spec);
-  const IndoorScene scene = makeRoom(spec.room);
+  IndoorScene scene;
+  try {
+    scene = makeRoom(spec.room);
+  } catch (const std::invalid_argument& e) {
+    throw SequenceSpecError(e.what());
+  }
   const SceneRenderer renderer(scene, spec.camera, spec.render);
   rosbag::Bag bag;
   try {
