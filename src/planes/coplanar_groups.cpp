@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/homography_four.h"
 #include "mono_plane_detection/planes/cross_ratio.h"
 
 namespace mono_plane_detection {
@@ -139,13 +140,12 @@ bool knownCoplanarityTest(const std::string& name) {
 
 double fifthPointError(const PointGroup& group, const std::vector<cv::Point2d>& view1,
                        const std::vector<cv::Point2d>& view2) {
-  // The homography of the four exactly (normalised DLT: 8 equations, 8 unknowns).
-  std::vector<cv::Point2d> from(4), to(4);
+  cv::Point2d from[4], to[4];
   for (int k = 0; k < 4; ++k) {
     from[k] = view1[group[k]];
     to[k] = view2[group[k]];
   }
-  const auto H = fitHomography(from, to);
+  const auto H = homographyFromFour(from, to);
   if (!H) return std::numeric_limits<double>::infinity();
   return transferError(*H, view1[group[4]], view2[group[4]]);
 }

@@ -83,22 +83,49 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        auto H = fitHomography(select(view1, both), select(view2, both));
-        if (!H) continue;
         std::vector<bool> in_union(view1.size(), false);
         for (int k : both) in_union[k] = true;
-        std::vector<int> union_inliers = both;
         PlaneParams p = params;
         p.vote_threshold_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
-        if (!refitPlane(*H, union_inliers, view1, view2, in_union, p)) continue;
+        // Every point of the two keeps its cheapest label either way (a point the merged
+        // plane does not explain may go to a third plane or become an outlier).
+        std::vector<double> others(both.size(), energy.k2);
+        double separate = 0.0;
+        for (size_t q = 0; q < both.size(); ++q) {
+          const int x = both[q];
+          for (size_t m = 0; m < planes.size(); ++m)
+            if (m != i && m != j)
+              others[q] = std::min(others[q], energy.point(planes[m], view1[x], view2[x]));
+          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x]),
+                                energy.point(planes[j], view1[x], view2[x])});
+        }
+        // The merged plane refitted robustly on the union from three starts (either
+        // plane's homography, least squares on the union), the cheapest kept: one start
+        // alone can stay with its own piece.
         Plane merged;
-        merged.H = *H;
-        merged.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
-        merged.threshold_px = p.vote_threshold_px;
-        if (estimate_noise) setPlaneNoise(merged, view1, view2, in_union, energy.sigma, params);
-        const double separate = energy.sum(planes[i], planes[i].inliers, view1, view2) +
-                                energy.sum(planes[j], planes[j].inliers, view1, view2);
-        const double gain = separate + energy.plane_cost - energy.sum(merged, both, view1, view2);
+        double together = std::numeric_limits<double>::infinity();
+        const auto union_fit = fitHomography(select(view1, both), select(view2, both));
+        for (const std::optional<cv::Matx33d>& start :
+             {std::optional<cv::Matx33d>(planes[i].H), std::optional<cv::Matx33d>(planes[j].H),
+              union_fit}) {
+          if (!start) continue;
+          Plane m;
+          m.H = *start;
+          std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
+          if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
+            continue;
+          m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
+          m.threshold_px = p.vote_threshold_px;
+          if (estimate_noise) setPlaneNoise(m, view1, view2, in_union, energy.sigma, params);
+          double cost = 0.0;
+          for (size_t q = 0; q < both.size(); ++q)
+            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]]));
+          if (cost < together) {
+            together = cost;
+            merged = m;
+          }
+        }
+        const double gain = separate + energy.plane_cost - together;
         if (gain > best_gain) {
           best_gain = gain;
           bi = i;
@@ -422,7 +449,7 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
     if (std::isfinite(pilot[k].fifth_error) && spread > 0)
       relative.push_back({pilot[k].fifth_error / spread, k});
   }
-  const size_t first = std::min(relative.size(), static_cast<size_t>(5 * params.noise_pilot_groups));
+  const size_t first = std::min(relative.size(), static_cast<size_t>(3 * params.noise_pilot_groups));
   std::partial_sort(relative.begin(), relative.begin() + static_cast<long>(first), relative.end());
   const size_t kth = std::min(view1.size() - 1, static_cast<size_t>(np.min_inliers));
   std::vector<std::pair<double, cv::Matx33d>> ranked;

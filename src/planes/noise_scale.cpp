@@ -60,7 +60,9 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
 
 namespace {
 
-double asscScore(const NoiseScale& s) { return s.inliers > 0 ? s.inliers / s.sigma_px : 0.0; }
+double asscScore(const NoiseScale& s) {
+  return s.inliers > 0 ? s.inliers / (s.sigma_px * s.sigma_px) : 0.0;
+}
 
 // Refits H on the inlier set of `scale` and estimates again while ASSC's score improves.
 NoiseScale refine(cv::Matx33d& H, NoiseScale scale, const std::vector<cv::Point2d>& view1,

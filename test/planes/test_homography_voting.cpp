@@ -79,6 +79,7 @@ TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {
   sp.outlier_fraction = 0.3;
   const auto scene = makeTwoViewScene(sp);
   PlaneParams params;
+  params.vote_threshold_px = 2.0;  // refitPlane takes the threshold as given
   cv::Matx33d H = scene.homographies[0] * shift(1.2);  // off by 1.2 px
   std::vector<int> inliers = inliersOf(H, scene.view1, scene.view2, {}, params.vote_threshold_px);
   ASSERT_TRUE(refitPlane(H, inliers, scene.view1, scene.view2, {}, params));
