@@ -107,6 +107,10 @@ int main(int argc, char** argv) {
               "core: inlier threshold, pixels; 0 = estimated (default)", "PX")
       .choice("coplanarity-test", &params.groups.coplanarity_test, {"transfer", "cross_ratio"},
               "core: five-point coplanarity test")
+      .integer("max-groups", &params.groups.max_groups, 1, 100000,
+               "core: coplanar groups kept per image pair")
+      .integer("tries-per-point", &params.groups.tries_per_point, 1, 100000,
+               "core: groups tried per point at most")
       .flag("epipolar-check", &params.epipolar_check,
             "core: reject homographies not induced by a plane of the estimated F")
       .number("magsac-threshold", &magsac_threshold, 0.01, 1e3,
