@@ -153,7 +153,7 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
 void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& candidates,
                  const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                  const PlaneParams& params, const Energy& energy, double vote_px,
-                 bool estimate_noise) {
+                 bool estimate_noise, const std::optional<cv::Matx33d>& F) {
   const size_t count = planes.size();
   for (size_t p = 0; p < count; ++p) {
     const std::vector<int> members = planes[p].inliers;
@@ -185,6 +185,9 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
       if (estimate_noise) setPlaneNoise(out, view1, view2, active, energy.sigma, params);
+      if (F && epipolarTransferError(out.H, *F, view1) >
+                   params.epipolar_threshold_sigma * energy.sigma)
+        return false;  // only plane-induced pieces
       return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
     };
     const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
@@ -584,7 +587,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     planes.push_back(std::move(plane));
   }
   refineAssignment(planes, view1, view2, params, energy, estimate);
-  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, estimate);
+  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, estimate, F);
   refineAssignment(planes, view1, view2, params, energy, estimate);
   mergeSamePlanes(planes, view1, view2, params, energy, estimate);
   refineAssignment(planes, view1, view2, params, energy, estimate);
