@@ -118,6 +118,8 @@ const ParamTable<GroupParams>& groupParamTable() {
        "max_tries"},
       {"tries_per_point", field(&P::tries_per_point), 1, 100000, "",
        "fewer points, fewer tries (max_tries still caps)"},
+      {"min_tries", field(&P::min_tries), 0, 10000000, "",
+       "but at least this many tries (few points need them)"},
       {"max_seeds", field(&P::max_seeds), 1, 1000000, "",
        "seed points with a neighbour list (bounds memory)"},
       {"neighbours", field(&P::neighbours), 4, 1000, "",

@@ -118,7 +118,7 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
   const long wanted =
       std::min<long>(params.max_groups, static_cast<long>(params.groups_per_point) * view2.size());
   const long max_tries =
-      std::min<long>(params.max_tries, static_cast<long>(params.tries_per_point) * view2.size());
+      triesFor(params, view2.size());
   GroupSampler sampler(view2, params);
   std::unordered_set<PointGroup, GroupHash> seen;
   seen.reserve(static_cast<size_t>(max_tries));
@@ -132,6 +132,11 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
     if (isCoplanarGroup(g, view1, view2, params, sigma_px)) out.groups.push_back(g);
   }
   return out;
+}
+
+long triesFor(const GroupParams& params, size_t points) {
+  const long scaled = static_cast<long>(params.tries_per_point) * static_cast<long>(points);
+  return std::min<long>(params.max_tries, std::max<long>(params.min_tries, scaled));
 }
 
 bool knownCoplanarityTest(const std::string& name) {

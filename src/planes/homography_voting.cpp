@@ -43,6 +43,7 @@ struct Energy {
   double k2;          // (membership threshold in noise scales)^2: an outlier's cost
   double sigma;       // the image pair's noise scale
   double plane_cost;  // label cost of one plane
+  double fixed_threshold_px;  // > 0: the user's threshold, every plane's
   double point(const Plane& p, const cv::Point2d& a, const cv::Point2d& b) const {
     const double u = transferError(p.H, a, b) / p.noise_px;
     if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
@@ -60,13 +61,18 @@ struct Energy {
 // image pair's scale, kept within a factor 4 of it), and its threshold.
 void setPlaneNoise(Plane& plane, const std::vector<cv::Point2d>& view1,
                    const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
-                   double sigma, const PlaneParams& params) {
+                   const Energy& energy, const PlaneParams& params) {
   std::vector<double> r;
   for (size_t i = 0; i < view1.size(); ++i)
     if (isActive(active, i)) r.push_back(transferError(plane.H, view1[i], view2[i]));
+  const double sigma = energy.sigma;
   const NoiseScale s = medianScale(r, sigma, params.noise.tail_sigmas);
   plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
-  plane.threshold_px = params.inlier_threshold_sigma * plane.noise_px;
+  // A fixed threshold stays every plane's; the scale still counts the plane's cost in its
+  // own units (an implied scale smaller than the data's would make splitting pay).
+  plane.threshold_px = energy.fixed_threshold_px > 0.0
+                           ? energy.fixed_threshold_px
+                           : params.inlier_threshold_sigma * plane.noise_px;
 }
 
 // Planes found one after another can be the same physical plane (split by noise):
@@ -74,7 +80,7 @@ void setPlaneNoise(Plane& plane, const std::vector<cv::Point2d>& view1,
 // than the two, one plane's label cost included. Best merge first, until none pays.
 void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
                      const std::vector<cv::Point2d>& view2, const PlaneParams& params,
-                     const Energy& energy, bool estimate_noise) {
+                     const Energy& energy) {
   for (;;) {
     double best_gain = 0.0;
     size_t bi = 0, bj = 0;
@@ -116,7 +122,7 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
             continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
           m.threshold_px = p.vote_threshold_px;
-          if (estimate_noise) setPlaneNoise(m, view1, view2, in_union, energy.sigma, params);
+          setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
           for (size_t q = 0; q < both.size(); ++q)
             cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]]));
@@ -153,7 +159,7 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
 void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& candidates,
                  const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                  const PlaneParams& params, const Energy& energy, double vote_px,
-                 bool estimate_noise, const std::optional<cv::Matx33d>& F) {
+                 const std::optional<cv::Matx33d>& F) {
   const size_t count = planes.size();
   for (size_t p = 0; p < count; ++p) {
     const std::vector<int> members = planes[p].inliers;
@@ -184,7 +190,7 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
         return false;
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
-      if (estimate_noise) setPlaneNoise(out, view1, view2, active, energy.sigma, params);
+      setPlaneNoise(out, view1, view2, active, energy, params);
       if (F && epipolarTransferError(out.H, *F, view1) >
                    params.epipolar_threshold_sigma * energy.sigma)
         return false;  // only plane-induced pieces
@@ -265,7 +271,7 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
 // a neighbouring plane, give those points back. Leaves planes[k].inliers set.
 void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
                       const std::vector<cv::Point2d>& view2, const PlaneParams& params,
-                      const Energy& energy, bool estimate_noise) {
+                      const Energy& energy) {
   std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
   for (int round = 0; round < params.refit_iterations; ++round) {
     for (size_t k = 0; k < planes.size(); ++k) {
@@ -279,11 +285,9 @@ void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>
       }
       if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]), w))
         planes[k].H = *H;
-      if (estimate_noise) {
-        std::vector<bool> mine(view1.size(), false);
-        for (int i : members[k]) mine[i] = true;
-        setPlaneNoise(planes[k], view1, view2, mine, energy.sigma, params);
-      }
+      std::vector<bool> mine(view1.size(), false);
+      for (int i : members[k]) mine[i] = true;
+      setPlaneNoise(planes[k], view1, view2, mine, energy, params);
     }
     std::vector<std::vector<int>> next =
         keepSupportedPlanes(planes, view1, view2, params, energy);
@@ -401,8 +405,7 @@ struct GroupDraw {
   GroupDraw(const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
             const GroupParams& params)
       : view1_(view1), view2_(view2), sampler_(view2, params) {
-    max_tries_ =
-        std::min<long>(params.max_tries, static_cast<long>(params.tries_per_point) * view2.size());
+    max_tries_ = triesFor(params, view2.size());
   }
   bool next(Drawn& d) {
     PointGroup g;
@@ -497,7 +500,10 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   // Groups: the first drawn (the pilot) give the noise scale unless the user fixed it.
   GroupDraw draw(view1, view2, user_params.groups);
   std::vector<GroupDraw::Drawn> drawn;
-  const long pilot_size = std::max<long>(200, 4L * static_cast<long>(view1.size()));
+  // (Only when the scale is to be estimated: a fixed one needs no pilot.)
+  const long pilot_size = fixedThresholds(user_params).sigma_px > 0.0
+                              ? 0L
+                              : std::max<long>(200, 4L * static_cast<long>(view1.size()));
   for (GroupDraw::Drawn d; static_cast<long>(drawn.size()) < pilot_size && draw.next(d);)
     drawn.push_back(d);
   Thresholds th = fixedThresholds(user_params);
@@ -516,7 +522,9 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   params.vote_threshold_px = vote_px;
   // An outlier costs (threshold / scale)^2: the membership threshold in noise scales.
   const double k = estimate ? params.inlier_threshold_sigma : params.vote_threshold_sigma;
-  const Energy energy{k * k, th.sigma_px, params.plane_penalty * std::log(static_cast<double>(view1.size()))};
+  const Energy energy{k * k, th.sigma_px,
+                      params.plane_penalty * std::log(static_cast<double>(view1.size())),
+                      estimate ? 0.0 : th.inlier_px};
 
   // Paper IV-B with the chosen test, until enough groups pass or the tries run out.
   const GroupParams& gp = params.groups;
@@ -573,7 +581,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     // its points under its own threshold.
     plane.noise_px = th.sigma_px;
     plane.threshold_px = th.inlier_px;
-    if (estimate) setPlaneNoise(plane, view1, view2, active, th.sigma_px, params);
+    setPlaneNoise(plane, view1, view2, active, energy, params);
     PlaneParams own = params;
     own.vote_threshold_px = plane.threshold_px;
     if (!refitPlane(plane.H, plane.inliers, view1, view2, active, own) ||
@@ -586,11 +594,11 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     for (int i : plane.inliers) active[i] = false;
     planes.push_back(std::move(plane));
   }
-  refineAssignment(planes, view1, view2, params, energy, estimate);
-  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, estimate, F);
-  refineAssignment(planes, view1, view2, params, energy, estimate);
-  mergeSamePlanes(planes, view1, view2, params, energy, estimate);
-  refineAssignment(planes, view1, view2, params, energy, estimate);
+  refineAssignment(planes, view1, view2, params, energy);
+  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, F);
+  refineAssignment(planes, view1, view2, params, energy);
+  mergeSamePlanes(planes, view1, view2, params, energy);
+  refineAssignment(planes, view1, view2, params, energy);
   std::stable_sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) {
     return a.inliers.size() > b.inliers.size();
   });

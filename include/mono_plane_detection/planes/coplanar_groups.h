@@ -17,7 +17,8 @@ struct GroupParams {
   int max_groups = 300;      // coplanar groups kept per image, so the cost stays bounded
   int groups_per_point = 4;  // fewer points -> fewer groups (max_groups still caps)
   int max_tries = 6000;      // groups tried at most: with many outliers few pass
-  int tries_per_point = 15;  // fewer points -> fewer tries (max_tries still caps)
+  int tries_per_point = 15;  // fewer points -> fewer tries (max_tries still caps) ...
+  int min_tries = 2000;      // ... but few points need as many tries as the paper's 40 / point
   int max_seeds = 2000;      // seed points with a neighbour list (bounds memory)
   int neighbours = 10;       // a group is a seed and 4 of its nearest neighbours
   // Neighbours closer than this to the seed are passed over: the invariants' relative
@@ -66,8 +67,7 @@ std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
                                     const GroupParams& params, int count);
 
 // Paper IV-A + IV-B: groups tried in GroupSampler's order until min(max_groups,
-// groups_per_point * N) pass isCoplanarGroup or min(max_tries, tries_per_point * N)
-// were tried. A group drawn again is skipped (it would give the same homography).
+// groups_per_point * N) pass isCoplanarGroup or triesFor(params, N) were tried. A group drawn again is skipped (it would give the same homography).
 struct CoplanarGroups {
   std::vector<PointGroup> groups;  // the accepted ones
   int tried = 0;
@@ -90,6 +90,10 @@ bool isCoplanarGroup(const PointGroup& group, const std::vector<cv::Point2d>& vi
 // first four define; infinity when those four are degenerate in either view.
 double fifthPointError(const PointGroup& group, const std::vector<cv::Point2d>& view1,
                        const std::vector<cv::Point2d>& view2);
+
+// Groups tried at most for this many points: tries_per_point per point, at least
+// min_tries, at most max_tries.
+long triesFor(const GroupParams& params, size_t points);
 
 // True for the two test names GroupParams::coplanarity_test accepts.
 bool knownCoplanarityTest(const std::string& name);
