@@ -150,6 +150,8 @@ static const ParamTable<NoiseScaleParams>& noiseScaleParamTable() {
        "the noise scale rests on at least this many points"},
       {"stop_sigmas", field(&P::stop_sigmas), 1, 20, "sigma",
        "noise estimate (MSSE): a residual beyond this many scales is not an inlier"},
+      {"tail_sigmas", field(&P::tail_sigmas), 1, 50, "sigma",
+       "noise estimate (median scale): heavy-tailed residuals count up to this many scales"},
       {"min_sigma_px", field(&P::min_sigma_px), 0.001, 100, "px",
        "the estimated noise scale is at least this"},
       {"max_sigma_px", field(&P::max_sigma_px), 0.001, 1000, "px", "and at most this"},

@@ -385,6 +385,17 @@ std::string checkPlaneParams(const PlaneParams& params) {
 
 namespace {
 
+// The membership threshold in noise scales from how heavy the residuals' tail is: the
+// vote's vote_threshold_sigma for Gaussian noise (tail ratio 1.82), inlier_threshold_sigma
+// from a tail ratio of 3 on (real matches), linear in between.
+double membershipSigmas(double tail_ratio, const PlaneParams& params) {
+  const double lo = std::min(params.vote_threshold_sigma, params.inlier_threshold_sigma);
+  const double hi = params.inlier_threshold_sigma;
+  if (!(tail_ratio > 0.0)) return hi;
+  const double t = std::clamp((tail_ratio - 1.82) / (3.0 - 1.82), 0.0, 1.0);
+  return lo + t * (hi - lo);
+}
+
 // Least k-th order statistic of H's transfer residuals (threshold-free fit quality).
 double kthResidual(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                    const std::vector<cv::Point2d>& view2, size_t kth, std::vector<double>& r) {
@@ -508,10 +519,12 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     drawn.push_back(d);
   Thresholds th = fixedThresholds(user_params);
   const bool estimate = th.sigma_px <= 0.0;
+  double membership_sigmas = user_params.inlier_threshold_sigma;
   if (estimate) {
     const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params);
     const double sigma = s.inliers > 0 ? s.sigma_px : user_params.noise.max_sigma_px;
-    th = {sigma, sigma * user_params.inlier_threshold_sigma};
+    membership_sigmas = membershipSigmas(s.tail_ratio, user_params);
+    th = {sigma, sigma * membership_sigmas};
   }
   // With an estimated scale the vote counts the planes' cores (vote_threshold_sigma); each
   // plane then takes its points within inlier_threshold_sigma of its own scale.
@@ -520,6 +533,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   out.threshold_px = th.inlier_px;
   PlaneParams params = user_params;
   params.vote_threshold_px = vote_px;
+  params.inlier_threshold_sigma = membership_sigmas;
   // An outlier costs (threshold / scale)^2: the membership threshold in noise scales.
   const double k = estimate ? params.inlier_threshold_sigma : params.vote_threshold_sigma;
   const Energy energy{k * k, th.sigma_px,

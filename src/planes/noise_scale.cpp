@@ -52,7 +52,10 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
     std::nth_element(in.begin(), in.begin() + in.size() / 2, in.end());
     const double next = in[in.size() / 2] / median_in_sigmas;
     const bool converged = std::abs(next - s.sigma_px) < 1e-3 * s.sigma_px;
-    s = {next, static_cast<int>(in.size())};
+    const double median = in[in.size() / 2];
+    std::nth_element(in.begin(), in.begin() + (in.size() * 9) / 10, in.end());
+    const double q90 = in[(in.size() * 9) / 10];
+    s = {next, static_cast<int>(in.size()), median > 0 ? q90 / median : 0.0};
     if (converged || !(next > 0)) break;
   }
   return s;
@@ -96,8 +99,10 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
                               const std::vector<cv::Point2d>& view1,
                               const std::vector<cv::Point2d>& view2,
                               const NoiseScaleParams& params) {
-  // ASSC's score (Wang and Suter 2004): inliers per unit of scale. The largest inlier set
-  // alone would pick a bad candidate whose residuals grow smoothly and never stop MSSE.
+  // Score: inliers per squared scale (ASSC's inliers per scale, Wang and Suter 2004,
+  // squared: a homography bridging two planes has about twice the points at twice the
+  // scale). The largest inlier set alone would pick a bad candidate whose residuals grow
+  // smoothly and never stop MSSE.
   // Each candidate came from 4-5 points; refitted on its inlier set its residuals are
   // those of the plane, not of the sample's own noise.
   NoiseScale best;
@@ -114,8 +119,8 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   }
   if (best.inliers == 0) return {};
   // MSSE stops at the first gap, which heavy-tailed noise puts inside the inliers: the
-  // best plane's residuals under a truncated Rayleigh model, cut at stop_sigmas, take the
-  // tail in as far as it is continuous.
+  // best plane's residuals under a truncated Rayleigh model (medianScale, cut at
+  // tail_sigmas) take the tail in as far as it is continuous.
   const NoiseScale t = medianScale(transferResiduals(*best_h, view1, view2), best.sigma_px,
                                    params.tail_sigmas, 30);
   if (t.inliers >= params.min_inliers) best = t;

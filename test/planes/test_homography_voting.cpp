@@ -265,13 +265,13 @@ RealScene readScene(const std::string& name) {
 }  // namespace
 
 // Real images, default settings, five seeds: AdelaideRMF sene (2 planes, 47 % outliers)
-// and elderhallb (3 planes, 48 % outliers). Measured: sene 2.8 % every seed (the paper's
-// fixed 2 px: 7.2 %), elderhallb 3.1-5.9 % over seeds 1-5 (4.7 % mean; 5.1 % over ten
-// seeds, one at 14 %: two of its planes meet at a shallow angle).
+// and elderhallb (3 planes, 48 % outliers). Measured: sene 2.8-3.6 % (the paper's fixed
+// 2 px: 6.4 %), elderhallb 6.4 % mean over seeds 1-5, worst 9.8 % (7.4 % over 20 seeds,
+// worst 14 %: two of its planes meet at a shallow angle; fixed 2 px: 8.2 %, worst 12.6 %).
 TEST(SegmentPlanes, RealScenesBelowAMisclassificationBound) {
   for (const auto& [name, mean_bound, worst_bound] :
        {std::make_tuple("adelaidermf_sene", 0.04, 0.05),
-        std::make_tuple("adelaidermf_elderhallb", 0.07, 0.10)}) {
+        std::make_tuple("adelaidermf_elderhallb", 0.075, 0.11)}) {
     const RealScene s = readScene(name);
     ASSERT_EQ(s.labels.size(), s.view1.size()) << name;
     ASSERT_GT(s.view1.size(), 200u) << name;

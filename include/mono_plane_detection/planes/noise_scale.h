@@ -14,6 +14,9 @@ namespace mono_plane_detection {
 struct NoiseScale {
   double sigma_px = 0.0;
   int inliers = 0;
+  // 90th over 50th percentile of the residuals under the scale's cut: 1.82 for Rayleigh
+  // (Gaussian noise), 2.5-4 for the heavy tails of real matches (AdelaideRMF); 0 unknown.
+  double tail_ratio = 0.0;
 };
 
 // MSSE (Bab-Hadiashar and Suter 1999) on transfer residuals of one model: residuals in
@@ -33,9 +36,9 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
                        int iterations = 30);
 
 // The noise scale of an image pair from candidate homographies (view 1 -> view 2): each
-// candidate's residuals get msseScale; the candidate with the most inliers per unit of
-// scale (ASSC's score; the best first plane) is refitted on its inlier set and its
-// residuals estimated again; medianScale on its residuals gives the scale. The result
+// candidate's residuals get msseScale, refitted on its inlier set while that improves the
+// score; the candidate with the most inliers per squared scale (after ASSC's score; the
+// best first plane) is kept; medianScale on its residuals gives the scale. The result
 // is clamped to [min_sigma_px, max_sigma_px]; {0, 0} when no candidate gives an estimate.
 struct NoiseScaleParams {
   int min_inliers = 8;         // a scale rests on at least this many points
