@@ -399,8 +399,7 @@ double membershipSigmas(double tail_ratio, const PlaneParams& params) {
 // Least k-th order statistic of H's transfer residuals (threshold-free fit quality).
 double kthResidual(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                    const std::vector<cv::Point2d>& view2, size_t kth, std::vector<double>& r) {
-  r.resize(view1.size());
-  for (size_t i = 0; i < view1.size(); ++i) r[i] = transferError(H, view1[i], view2[i]);
+  r = transferResiduals(H, view1, view2);
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
   return r[kth];
 }

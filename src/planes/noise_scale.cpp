@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
@@ -16,13 +17,26 @@ NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_d
   const int n = static_cast<int>(residuals.size());
   min_inliers = std::max(min_inliers, model_dof / 2 + 1);  // 2k - dof > 0
   if (n < min_inliers) return {};
-  std::sort(residuals.begin(), residuals.end());
+  // Sorted lazily: the smallest part first, the rest only when the inliers reach into it
+  // (a good candidate stops early; this runs for every pilot candidate).
+  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, n / 2));
+  std::partial_sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted),
+                    residuals.end());
+  auto ensure = [&](int k) {
+    if (static_cast<size_t>(k) >= sorted) {
+      std::sort(residuals.begin() + static_cast<long>(sorted), residuals.end());
+      sorted = residuals.size();
+    }
+  };
   double sum = 0.0;
   for (int k = 1; k <= n; ++k) {
+    ensure(k - 1);
     sum += residuals[k - 1] * residuals[k - 1];
     if (k < min_inliers) continue;
     const double sigma = std::sqrt(sum / (2.0 * k - model_dof));
-    if (k == n || residuals[k] > stop_sigmas * sigma) return {sigma, k};
+    if (k == n) return {sigma, k};
+    ensure(k);
+    if (residuals[k] > stop_sigmas * sigma) return {sigma, k};
   }
   return {};
 }
@@ -30,7 +44,18 @@ NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_d
 std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                                       const std::vector<cv::Point2d>& view2) {
   std::vector<double> r(view1.size());
-  for (size_t i = 0; i < view1.size(); ++i) r[i] = transferError(H, view1[i], view2[i]);
+  for (size_t i = 0; i < view1.size(); ++i) {
+    // transferError without std::hypot (overflow-safe but slow; pixels do not overflow).
+    const cv::Point2d& a = view1[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    if (std::abs(w) < 1e-12) {
+      r[i] = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
+    r[i] = std::sqrt(dx * dx + dy * dy);
+  }
   return r;
 }
 
@@ -73,7 +98,7 @@ NoiseScale refine(cv::Matx33d& H, NoiseScale scale, const std::vector<cv::Point2
   for (int round = 0; round < 3; ++round) {
     const std::vector<double> r = transferResiduals(H, view1, view2);
     std::vector<double> sorted = r;
-    std::sort(sorted.begin(), sorted.end());
+    std::nth_element(sorted.begin(), sorted.begin() + (scale.inliers - 1), sorted.end());
     const double cut = sorted[scale.inliers - 1];
     std::vector<cv::Point2d> a, b;
     for (size_t i = 0; i < r.size(); ++i) {
