@@ -20,8 +20,9 @@ NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_d
   // Sorted lazily: the smallest part first, the rest only when the inliers reach into it
   // (a good candidate stops early; this runs for every pilot candidate).
   size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, n / 2));
-  std::partial_sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted),
-                    residuals.end());
+  std::nth_element(residuals.begin(), residuals.begin() + static_cast<long>(sorted) - 1,
+                   residuals.end());
+  std::sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted));
   auto ensure = [&](int k) {
     if (static_cast<size_t>(k) >= sorted) {
       std::sort(residuals.begin() + static_cast<long>(sorted), residuals.end());
