@@ -165,6 +165,8 @@ const ParamTable<GroupParams>& groupParamTable() {
        "max_tries"},
       {"tries_per_point", field(&P::tries_per_point), 1, 100000, "",
        "fewer points, fewer tries (max_tries still caps)"},
+      {"min_tries", field(&P::min_tries), 0, 10000000, "",
+       "but at least this many tries (few points need them)"},
       {"max_seeds", field(&P::max_seeds), 1, 1000000, "",
        "seed points with a neighbour list (bounds memory)"},
       {"neighbours", field(&P::neighbours), 4, 1000, "",
@@ -173,10 +175,33 @@ const ParamTable<GroupParams>& groupParamTable() {
        "closer neighbours are passed over (invariant noise grows as the group shrinks)"},
       {"min_shape", field(&P::min_shape), 0, 1, "",
        "triangle shape below this is collinear (paper IV-A)"},
+      {"coplanarity_test", field(&P::coplanarity_test), 0, 0, "",
+       "five-point test: transfer (fifth point under the other four's homography, in noise "
+       "scales) or cross_ratio (paper IV-B)"},
+      {"transfer_threshold_sigma", field(&P::transfer_threshold_sigma), 0.1, 1000, "sigma",
+       "transfer test: the fifth point within this many noise scales"},
       {"invariant_threshold", field(&P::invariant_threshold), 1e-6, 10, "",
-       "five-point invariants equal within this (relative)", "invariant_threshold"},
+       "cross_ratio test: five-point invariants equal within this (relative)",
+       "invariant_threshold"},
       {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable",
        "group_seed"},
+  };
+  return table;
+}
+
+// The noise scale estimate's bounds (planes/noise_scale.h); a part of the plane table.
+static const ParamTable<NoiseScaleParams>& noiseScaleParamTable() {
+  using P = NoiseScaleParams;
+  static const ParamTable<P> table{
+      {"min_inliers", field(&P::min_inliers), 5, 100000, "",
+       "the noise scale rests on at least this many points"},
+      {"stop_sigmas", field(&P::stop_sigmas), 1, 20, "sigma",
+       "noise estimate (MSSE): a residual beyond this many scales is not an inlier"},
+      {"tail_sigmas", field(&P::tail_sigmas), 1, 50, "sigma",
+       "noise estimate (median scale): heavy-tailed residuals count up to this many scales"},
+      {"min_sigma_px", field(&P::min_sigma_px), 0.001, 100, "px",
+       "the estimated noise scale is at least this"},
+      {"max_sigma_px", field(&P::max_sigma_px), 0.001, 1000, "px", "and at most this"},
   };
   return table;
 }
@@ -185,9 +210,19 @@ const ParamTable<PlaneParams>& planeParamTable() {
   using P = PlaneParams;
   static const ParamTable<P> table = [] {
     ParamTable<P> t{
-        {"vote_threshold_px", field(&P::vote_threshold_px), 0.01, 100, "px",
-         "transfer error below which a point votes for a homography (paper: 2)",
+        {"vote_threshold_px", field(&P::vote_threshold_px), 0, 100, "px",
+         "transfer error below which a point votes / belongs; 0: inlier_threshold_sigma x the "
+         "noise scale estimated per image pair (paper: 2 fixed)",
          "vote_threshold_px"},
+        {"inlier_threshold_sigma", field(&P::inlier_threshold_sigma), 0.5, 50, "sigma",
+         "estimated scale: a point belongs to a plane within this many of the plane's own "
+         "noise scales"},
+        {"vote_threshold_sigma", field(&P::vote_threshold_sigma), 0.5, 50, "sigma",
+         "estimated scale: the vote counts within this many of the image pair's noise scales "
+         "(fixed threshold: the threshold is this many noise scales)"},
+        {"plane_penalty", field(&P::plane_penalty), 0, 1000, "sigma^2",
+         "model selection (add, drop, split, merge): a plane costs this x ln(points) squared "
+         "noise scales"},
         {"min_plane_support", field(&P::min_plane_support), 5, 100000, "",
          "points a plane needs", "min_plane_support"},
         {"max_planes", field(&P::max_planes), 1, 1000, "", "planes per image at most",
@@ -195,10 +230,15 @@ const ParamTable<PlaneParams>& planeParamTable() {
         {"refit_iterations", field(&P::refit_iterations), 0, 100, "",
          "refit on inliers / recompute inliers rounds"},
         {"robust_refit", field(&P::robust_refit), 0, 1, "", "Cauchy re-weighting in the refit"},
-        {"merge_fraction", field(&P::merge_fraction), 0, 1, "",
-         "merge two planes when one refit explains this share of each"},
+        {"noise_pilot_groups", field(&P::noise_pilot_groups), 1, 10000, "",
+         "candidate first planes the noise scale is estimated from"},
+        {"epipolar_check", field(&P::epipolar_check), 0, 1, "",
+         "reject homographies not induced by a plane of the estimated fundamental matrix"},
+        {"epipolar_threshold_sigma", field(&P::epipolar_threshold_sigma), 0.1, 1000, "sigma",
+         "epipolar check: median epipolar transfer error allowed, noise scales"},
     };
     appendNested(t, "groups/", &P::groups, groupParamTable());
+    appendNested(t, "noise/", &P::noise, noiseScaleParamTable());
     return t;
   }();
   return table;

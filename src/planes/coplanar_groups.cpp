@@ -1,10 +1,13 @@
 #include "mono_plane_detection/planes/coplanar_groups.h"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <unordered_set>
 
+#include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/homography_four.h"
 #include "mono_plane_detection/planes/cross_ratio.h"
 
 namespace mono_plane_detection {
@@ -110,12 +113,12 @@ std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
 
 CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
                                   const std::vector<cv::Point2d>& view2,
-                                  const GroupParams& params) {
+                                  const GroupParams& params, double sigma_px) {
   CoplanarGroups out;
   const long wanted =
       std::min<long>(params.max_groups, static_cast<long>(params.groups_per_point) * view2.size());
   const long max_tries =
-      std::min<long>(params.max_tries, static_cast<long>(params.tries_per_point) * view2.size());
+      triesFor(params, view2.size());
   GroupSampler sampler(view2, params);
   std::unordered_set<PointGroup, GroupHash> seen;
   seen.reserve(static_cast<size_t>(max_tries));
@@ -126,13 +129,37 @@ CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
     PointGroup key = g;
     std::sort(key.begin(), key.end());
     if (!seen.insert(key).second) continue;
-    if (isCoplanarGroup(g, view1, view2, params)) out.groups.push_back(g);
+    if (isCoplanarGroup(g, view1, view2, params, sigma_px)) out.groups.push_back(g);
   }
   return out;
 }
 
+long triesFor(const GroupParams& params, size_t points) {
+  const long scaled = static_cast<long>(params.tries_per_point) * static_cast<long>(points);
+  return std::min<long>(params.max_tries, std::max<long>(params.min_tries, scaled));
+}
+
+bool knownCoplanarityTest(const std::string& name) {
+  return name == "transfer" || name == "cross_ratio";
+}
+
+double fifthPointError(const PointGroup& group, const std::vector<cv::Point2d>& view1,
+                       const std::vector<cv::Point2d>& view2) {
+  cv::Point2d from[4], to[4];
+  for (int k = 0; k < 4; ++k) {
+    from[k] = view1[group[k]];
+    to[k] = view2[group[k]];
+  }
+  const auto H = homographyFromFour(from, to);
+  if (!H) return std::numeric_limits<double>::infinity();
+  return transferError(*H, view1[group[4]], view2[group[4]]);
+}
+
 bool isCoplanarGroup(const PointGroup& group, const std::vector<cv::Point2d>& view1,
-                     const std::vector<cv::Point2d>& view2, const GroupParams& params) {
+                     const std::vector<cv::Point2d>& view2, const GroupParams& params,
+                     double sigma_px) {
+  if (params.coplanarity_test == "transfer" && sigma_px > 0.0)
+    return fifthPointError(group, view1, view2) <= params.transfer_threshold_sigma * sigma_px;
   const auto a = fivePointInvariants(pick(group, view1), params.min_shape);
   const auto b = fivePointInvariants(pick(group, view2), params.min_shape);
   return a && b && invariantDistance(*a, *b) <= params.invariant_threshold;

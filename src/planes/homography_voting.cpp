@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
+#include <tuple>
+#include <unordered_set>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/planes/epipolar_check.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -31,68 +35,195 @@ double rmsError(const cv::Matx33d& H, const std::vector<int>& idx,
   return idx.empty() ? 0.0 : std::sqrt(sum / idx.size());
 }
 
-// One homography per group that passes the invariant test (paper IV-B, IV-C).
-std::vector<cv::Matx33d> coplanarGroupHomographies(const std::vector<cv::Point2d>& view1,
-                                                   const std::vector<cv::Point2d>& view2,
-                                                   const GroupParams& params,
-                                                   PlaneSegmentation& out) {
-  const CoplanarGroups found = findCoplanarGroups(view1, view2, params);
-  out.groups_built = found.tried;
-  out.groups_coplanar = static_cast<int>(found.groups.size());
-  out.accepted_groups = found.groups;
-  std::vector<cv::Matx33d> homographies;
-  for (const PointGroup& g : found.groups) {
-    const std::vector<int> idx(g.begin(), g.end());
-    if (auto H = fitHomography(select(view1, idx), select(view2, idx))) homographies.push_back(*H);
+// The model-selection criterion (PlaneParams), -2 log-likelihood up to a constant: a
+// point on plane p costs r^2 / sigma_p^2 + 4 ln(sigma_p / sigma) (a Gaussian of the
+// plane's own scale, so that a plane made broad by points of two planes pays for its
+// width), truncated at k^2, an outlier's cost.
+struct Energy {
+  double k2;          // (membership threshold in noise scales)^2: an outlier's cost
+  double sigma;       // the image pair's noise scale
+  double plane_cost;  // label cost of one plane
+  double fixed_threshold_px;  // > 0: the user's threshold, every plane's
+  double point(const Plane& p, const cv::Point2d& a, const cv::Point2d& b) const {
+    const double u = transferError(p.H, a, b) / p.noise_px;
+    if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
+    return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), k2);
   }
-  return homographies;
+  double sum(const Plane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
+             const std::vector<cv::Point2d>& view2) const {
+    double e = 0.0;
+    for (int i : idx) e += point(p, view1[i], view2[i]);
+    return e;
+  }
+};
+
+// The plane's noise scale from its residuals over the points (medianScale from the
+// image pair's scale, kept within a factor 4 of it), and its threshold.
+void setPlaneNoise(Plane& plane, const std::vector<cv::Point2d>& view1,
+                   const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
+                   const Energy& energy, const PlaneParams& params) {
+  std::vector<double> r;
+  for (size_t i = 0; i < view1.size(); ++i)
+    if (isActive(active, i)) r.push_back(transferError(plane.H, view1[i], view2[i]));
+  const double sigma = energy.sigma;
+  const NoiseScale s = medianScale(r, sigma, params.noise.tail_sigmas);
+  plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
+  // A fixed threshold stays every plane's; the scale still counts the plane's cost in its
+  // own units (an implied scale smaller than the data's would make splitting pay).
+  plane.threshold_px = energy.fixed_threshold_px > 0.0
+                           ? energy.fixed_threshold_px
+                           : params.inlier_threshold_sigma * plane.noise_px;
 }
 
 // Planes found one after another can be the same physical plane (split by noise):
-// merge two when one homography fitted on both explains most of each.
+// two are merged when the criterion says so: one homography refitted on both costs less
+// than the two, one plane's label cost included. Best merge first, until none pays.
 void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
-                     const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
-  for (bool merged = true; merged;) {
-    merged = false;
-    for (size_t i = 0; i < planes.size() && !merged; ++i) {
-      for (size_t j = i + 1; j < planes.size() && !merged; ++j) {
+                     const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                     const Energy& energy) {
+  for (;;) {
+    double best_gain = 0.0;
+    size_t bi = 0, bj = 0;
+    Plane best_plane;
+    for (size_t i = 0; i < planes.size(); ++i) {
+      for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        // Judged after the same robust refit a plane gets, on the union's points only.
-        auto H = fitHomography(select(view1, both), select(view2, both));
-        if (!H) continue;
         std::vector<bool> in_union(view1.size(), false);
         for (int k : both) in_union[k] = true;
-        std::vector<int> union_inliers = both;
-        if (!refitPlane(*H, union_inliers, view1, view2, in_union, params)) continue;
-        auto explained = [&](const std::vector<int>& idx) {
-          int n = 0;
-          for (int k : idx) n += transfersWithin(*H, view1[k], view2[k], params.vote_threshold_px);
-          return static_cast<double>(n) / std::max<size_t>(1, idx.size());
-        };
-        if (explained(planes[i].inliers) >= params.merge_fraction &&
-            explained(planes[j].inliers) >= params.merge_fraction) {
-          std::sort(both.begin(), both.end());
-          planes[i].H = *H;
-          planes[i].inliers = both;
-          planes.erase(planes.begin() + j);
-          merged = true;
+        PlaneParams p = params;
+        p.vote_threshold_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
+        // Every point of the two keeps its cheapest label either way (a point the merged
+        // plane does not explain may go to a third plane or become an outlier).
+        std::vector<double> others(both.size(), energy.k2);
+        double separate = 0.0;
+        for (size_t q = 0; q < both.size(); ++q) {
+          const int x = both[q];
+          for (size_t m = 0; m < planes.size(); ++m)
+            if (m != i && m != j)
+              others[q] = std::min(others[q], energy.point(planes[m], view1[x], view2[x]));
+          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x]),
+                                energy.point(planes[j], view1[x], view2[x])});
+        }
+        // The merged plane refitted robustly on the union from three starts (either
+        // plane's homography, least squares on the union), the cheapest kept: one start
+        // alone can stay with its own piece.
+        Plane merged;
+        double together = std::numeric_limits<double>::infinity();
+        const auto union_fit = fitHomography(select(view1, both), select(view2, both));
+        for (const std::optional<cv::Matx33d>& start :
+             {std::optional<cv::Matx33d>(planes[i].H), std::optional<cv::Matx33d>(planes[j].H),
+              union_fit}) {
+          if (!start) continue;
+          Plane m;
+          m.H = *start;
+          std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
+          if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
+            continue;
+          m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
+          m.threshold_px = p.vote_threshold_px;
+          setPlaneNoise(m, view1, view2, in_union, energy, params);
+          double cost = 0.0;
+          for (size_t q = 0; q < both.size(); ++q)
+            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]]));
+          if (cost < together) {
+            together = cost;
+            merged = m;
+          }
+        }
+        const double gain = separate + energy.plane_cost - together;
+        if (gain > best_gain) {
+          best_gain = gain;
+          bi = i;
+          bj = j;
+          best_plane = merged;
         }
       }
     }
+    if (best_gain <= 0.0) return;
+    planes[bi].H = best_plane.H;
+    planes[bi].noise_px = best_plane.noise_px;
+    planes[bi].threshold_px = best_plane.threshold_px;
+    planes[bi].inliers.insert(planes[bi].inliers.end(), planes[bj].inliers.begin(),
+                              planes[bj].inliers.end());
+    std::sort(planes[bi].inliers.begin(), planes[bi].inliers.end());
+    planes.erase(planes.begin() + static_cast<long>(bj));
   }
 }
 
-// Every point goes to the plane that explains it best, or to none.
+// A plane found by the vote can hold two physical planes whose homographies agree within
+// the vote's threshold. Split move under the same criterion: the candidate with most votes
+// among the plane's points that does not explain nearly all of them, and the best
+// candidate on the rest, each refitted with its own scale; the plane is replaced by the
+// two when their cost plus one more label cost is below its cost.
+void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& candidates,
+                 const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
+                 const PlaneParams& params, const Energy& energy, double vote_px,
+                 const std::optional<cv::Matx33d>& F) {
+  const size_t count = planes.size();
+  for (size_t p = 0; p < count; ++p) {
+    const std::vector<int> members = planes[p].inliers;
+    if (static_cast<int>(members.size()) < 2 * params.min_plane_support) continue;
+    std::vector<bool> mine(view1.size(), false);
+    for (int i : members) mine[i] = true;
+    auto best_candidate = [&](const std::vector<bool>& active, size_t max_votes) {
+      int best = -1;
+      size_t best_votes = 0;
+      for (size_t c = 0; c < candidates.size(); ++c) {
+        size_t votes = 0;
+        for (int i : members)
+          votes += active[i] && transfersWithin(candidates[c], view1[i], view2[i], vote_px);
+        if (votes > best_votes && votes <= max_votes) {
+          best_votes = votes;
+          best = static_cast<int>(c);
+        }
+      }
+      return best;
+    };
+    auto make = [&](int c, const std::vector<bool>& active, Plane& out) {
+      out.H = candidates[c];
+      out.inliers = inliersOf(out.H, view1, view2, active, vote_px);
+      PlaneParams vp = params;
+      vp.vote_threshold_px = vote_px;
+      if (static_cast<int>(out.inliers.size()) < params.min_plane_support ||
+          !refitPlane(out.H, out.inliers, view1, view2, active, vp))
+        return false;
+      out.noise_px = planes[p].noise_px;
+      out.threshold_px = planes[p].threshold_px;
+      setPlaneNoise(out, view1, view2, active, energy, params);
+      if (F && epipolarTransferError(out.H, *F, view1) >
+                   params.epipolar_threshold_sigma * energy.sigma)
+        return false;  // only plane-induced pieces
+      return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
+    };
+    const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
+    Plane A, B;
+    if (a < 0 || !make(a, mine, A)) continue;
+    std::vector<bool> rest = mine;
+    for (int i : A.inliers) rest[i] = false;
+    const int b = best_candidate(rest, members.size());
+    if (b < 0 || !make(b, rest, B)) continue;
+    double split_cost = 2.0 * energy.plane_cost, whole_cost = energy.plane_cost;
+    for (int i : members) {
+      split_cost += std::min(energy.point(A, view1[i], view2[i]), energy.point(B, view1[i], view2[i]));
+      whole_cost += energy.point(planes[p], view1[i], view2[i]);
+    }
+    if (split_cost >= whole_cost) continue;
+    planes[p] = A;
+    planes.push_back(B);
+  }
+}
+
+// Every point goes to the plane that explains it at least cost, or to none.
 std::vector<int> assignPoints(const std::vector<Plane>& planes,
                               const std::vector<cv::Point2d>& view1,
-                              const std::vector<cv::Point2d>& view2, double threshold_px) {
+                              const std::vector<cv::Point2d>& view2, const Energy& energy) {
   std::vector<int> labels(view1.size(), 0);
   for (size_t i = 0; i < view1.size(); ++i) {
     if (!finite(view1[i]) || !finite(view2[i])) continue;
-    double best = threshold_px;
+    double best = energy.k2;
     for (size_t k = 0; k < planes.size(); ++k) {
-      const double e = transferError(planes[k].H, view1[i], view2[i]);
+      const double e = energy.point(planes[k], view1[i], view2[i]);
       if (e < best) {
         best = e;
         labels[i] = static_cast<int>(k) + 1;
@@ -102,26 +233,36 @@ std::vector<int> assignPoints(const std::vector<Plane>& planes,
   return labels;
 }
 
-// assignPoints, then drops the least supported plane while it has fewer than
-// min_plane_support points, assigning again each time. Returns each plane's points.
+// assignPoints, then drops the plane that pays least for itself while one does not pay
+// (its points cost less than its label cost more under the other planes or as outliers)
+// or has fewer than min_plane_support points, assigning again each time. Returns each
+// plane's points.
 std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
                                                   const std::vector<cv::Point2d>& view1,
                                                   const std::vector<cv::Point2d>& view2,
-                                                  const PlaneParams& params) {
+                                                  const PlaneParams& params, const Energy& energy) {
   for (;;) {
-    const std::vector<int> labels = assignPoints(planes, view1, view2, params.vote_threshold_px);
+    const std::vector<int> labels = assignPoints(planes, view1, view2, energy);
     std::vector<std::vector<int>> members(planes.size());
+    std::vector<double> gain(planes.size(), -energy.plane_cost);
     for (size_t i = 0; i < labels.size(); ++i) {
-      if (labels[i] > 0) members[labels[i] - 1].push_back(static_cast<int>(i));
+      if (labels[i] <= 0) continue;
+      const size_t k = static_cast<size_t>(labels[i] - 1);
+      members[k].push_back(static_cast<int>(i));
+      double second = energy.k2;  // without plane k: the next best plane, or an outlier
+      for (size_t m = 0; m < planes.size(); ++m)
+        if (m != k) second = std::min(second, energy.point(planes[m], view1[i], view2[i]));
+      gain[k] += second - energy.point(planes[k], view1[i], view2[i]);
     }
-    const auto smallest = std::min_element(
-        members.begin(), members.end(),
-        [](const std::vector<int>& a, const std::vector<int>& b) { return a.size() < b.size(); });
-    if (smallest == members.end() ||
-        static_cast<int>(smallest->size()) >= params.min_plane_support) {
-      return members;
+    long worst = -1;
+    for (size_t k = 0; k < planes.size(); ++k) {
+      const bool fails = static_cast<int>(members[k].size()) < params.min_plane_support ||
+                         gain[k] < 0.0;
+      if (fails && (worst < 0 || gain[k] < gain[static_cast<size_t>(worst)]))
+        worst = static_cast<long>(k);
     }
-    planes.erase(planes.begin() + (smallest - members.begin()));
+    if (worst < 0) return members;
+    planes.erase(planes.begin() + worst);
   }
 }
 
@@ -129,14 +270,27 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
 // points until the labels stop changing: pieces found early, which hold a few points of
 // a neighbouring plane, give those points back. Leaves planes[k].inliers set.
 void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
-                      const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
-  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params);
+                      const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                      const Energy& energy) {
+  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
   for (int round = 0; round < params.refit_iterations; ++round) {
     for (size_t k = 0; k < planes.size(); ++k) {
-      if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k])))
+      // Cauchy weights at the plane's own scale: a heavy tail does not pull the fit.
+      std::vector<double> w;
+      if (params.robust_refit) {
+        for (int i : members[k]) {
+          const double u = transferError(planes[k].H, view1[i], view2[i]) / (2.0 * planes[k].noise_px);
+          w.push_back(std::isfinite(u) ? 1.0 / (1.0 + u * u) : 0.0);
+        }
+      }
+      if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]), w))
         planes[k].H = *H;
+      std::vector<bool> mine(view1.size(), false);
+      for (int i : members[k]) mine[i] = true;
+      setPlaneNoise(planes[k], view1, view2, mine, energy, params);
     }
-    std::vector<std::vector<int>> next = keepSupportedPlanes(planes, view1, view2, params);
+    std::vector<std::vector<int>> next =
+        keepSupportedPlanes(planes, view1, view2, params, energy);
     const bool stable = next == members;
     members = std::move(next);
     if (stable) break;
@@ -215,26 +369,214 @@ bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv:
   return true;
 }
 
-PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
-                                const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
-  PlaneSegmentation out;
-  if (view1.size() != view2.size()) {
-    out.error = "the two views have different numbers of points";
-    return out;
+Thresholds fixedThresholds(const PlaneParams& params) {
+  if (params.vote_threshold_px <= 0.0 || params.vote_threshold_sigma <= 0.0) return {};
+  return {params.vote_threshold_px / params.vote_threshold_sigma, params.vote_threshold_px};
+}
+
+std::string checkPlaneParams(const PlaneParams& params) {
+  if (!knownCoplanarityTest(params.groups.coplanarity_test))
+    return "unknown coplanarity_test '" + params.groups.coplanarity_test +
+           "' (transfer or cross_ratio)";
+  if (!(params.inlier_threshold_sigma > 0.0) || !(params.vote_threshold_sigma > 0.0))
+    return "inlier_threshold_sigma and vote_threshold_sigma must be positive";
+  return {};
+}
+
+namespace {
+
+// The membership threshold in noise scales from how heavy the residuals' tail is: the
+// vote's vote_threshold_sigma for Gaussian noise (tail ratio 1.82), inlier_threshold_sigma
+// from a tail ratio of 3 on (real matches), linear in between.
+double membershipSigmas(double tail_ratio, const PlaneParams& params) {
+  const double lo = std::min(params.vote_threshold_sigma, params.inlier_threshold_sigma);
+  const double hi = params.inlier_threshold_sigma;
+  if (!(tail_ratio > 0.0)) return hi;
+  const double t = std::clamp((tail_ratio - 1.82) / (3.0 - 1.82), 0.0, 1.0);
+  return lo + t * (hi - lo);
+}
+
+// Least k-th order statistic of H's transfer residuals (threshold-free fit quality).
+double kthResidual(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                   const std::vector<cv::Point2d>& view2, size_t kth, std::vector<double>& r) {
+  r = transferResiduals(H, view1, view2);
+  std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
+  return r[kth];
+}
+
+// Groups drawn as findCoplanarGroups draws them (GroupSampler, repeats skipped), each with
+// its fifth point's transfer error, so that the noise scale can be estimated from the
+// first ones before any is tested.
+struct GroupDraw {
+  struct Drawn {
+    PointGroup group;
+    double fifth_error;
+  };
+  GroupDraw(const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
+            const GroupParams& params)
+      : view1_(view1), view2_(view2), sampler_(view2, params) {
+    max_tries_ = triesFor(params, view2.size());
   }
+  bool next(Drawn& d) {
+    PointGroup g;
+    while (tried < max_tries_ && sampler_.next(g)) {
+      ++tried;
+      PointGroup key = g;
+      std::sort(key.begin(), key.end());
+      if (!seen_.insert(key).second) continue;
+      d = {g, fifthPointError(g, view1_, view2_)};
+      return true;
+    }
+    return false;
+  }
+  int tried = 0;
+
+ private:
+  struct Hash {
+    size_t operator()(const PointGroup& g) const {
+      size_t h = 0;
+      for (int i : g) h = h * 1000003u + static_cast<size_t>(i);
+      return h;
+    }
+  };
+  const std::vector<cv::Point2d>& view1_;
+  const std::vector<cv::Point2d>& view2_;
+  GroupSampler sampler_;
+  std::unordered_set<PointGroup, Hash> seen_;
+  long max_tries_ = 0;
+};
+
+// The noise scale from the best first plane among the pilot's groups: those whose fifth
+// point transfers best relative to the group's size (scale-free), then among their
+// homographies the noise_pilot_groups with the least k-th smallest residual (k = a tenth
+// of the points; threshold-free, robust to 90 % of the points off the plane) go to
+// estimateNoiseScale.
+NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
+                           const std::vector<cv::Point2d>& view1,
+                           const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
+  NoiseScaleParams np = params.noise;
+  np.min_inliers = std::max({np.min_inliers, params.min_plane_support,
+                             static_cast<int>(view1.size() / 10)});
+  std::vector<std::pair<double, size_t>> relative;
+  for (size_t k = 0; k < pilot.size(); ++k) {
+    const PointGroup& g = pilot[k].group;
+    double spread = 0.0;
+    for (int i : g) spread += cv::norm(view2[i] - view2[g[0]]);
+    if (std::isfinite(pilot[k].fifth_error) && spread > 0)
+      relative.push_back({pilot[k].fifth_error / spread, k});
+  }
+  const size_t first = std::min(relative.size(), static_cast<size_t>(3 * params.noise_pilot_groups));
+  std::partial_sort(relative.begin(), relative.begin() + static_cast<long>(first), relative.end());
+  const size_t kth = std::min(view1.size() - 1, static_cast<size_t>(np.min_inliers));
+  std::vector<std::pair<double, cv::Matx33d>> ranked;
+  std::vector<double> r;
+  for (size_t k = 0; k < first; ++k) {
+    const PointGroup& g = pilot[relative[k].second].group;
+    const std::vector<int> idx(g.begin(), g.end());
+    if (const auto H = fitHomography(select(view1, idx), select(view2, idx)))
+      ranked.push_back({kthResidual(*H, view1, view2, kth, r), *H});
+  }
+  const size_t keep = std::min(ranked.size(), static_cast<size_t>(params.noise_pilot_groups));
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<long>(keep), ranked.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<cv::Matx33d> candidates;
+  for (size_t k = 0; k < keep; ++k) candidates.push_back(ranked[k].second);
+  return estimateNoiseScale(candidates, view1, view2, np);
+}
+
+// Indices of the first copy of every correspondence; dup_of[i] = index of i's first copy.
+std::vector<int> uniqueCorrespondences(const std::vector<cv::Point2d>& view1,
+                                       const std::vector<cv::Point2d>& view2,
+                                       std::vector<int>& dup_of) {
+  std::map<std::tuple<double, double, double, double>, int> first;
+  std::vector<int> keep;
+  dup_of.assign(view1.size(), -1);
+  for (size_t i = 0; i < view1.size(); ++i) {
+    const auto key = std::make_tuple(view1[i].x, view1[i].y, view2[i].x, view2[i].y);
+    const auto it = first.emplace(key, static_cast<int>(i));
+    dup_of[i] = it.first->second;
+    if (it.second) keep.push_back(static_cast<int>(i));
+  }
+  return keep;
+}
+
+PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
+                                const std::vector<cv::Point2d>& view2,
+                                const PlaneParams& user_params) {
+  PlaneSegmentation out;
   out.labels.assign(view1.size(), 0);
   if (view1.size() < 5) return out;
 
-  std::vector<cv::Matx33d> candidates = coplanarGroupHomographies(view1, view2, params.groups, out);
+  // Groups: the first drawn (the pilot) give the noise scale unless the user fixed it.
+  GroupDraw draw(view1, view2, user_params.groups);
+  std::vector<GroupDraw::Drawn> drawn;
+  // (Only when the scale is to be estimated: a fixed one needs no pilot.)
+  const long pilot_size = fixedThresholds(user_params).sigma_px > 0.0
+                              ? 0L
+                              : std::max<long>(200, 4L * static_cast<long>(view1.size()));
+  for (GroupDraw::Drawn d; static_cast<long>(drawn.size()) < pilot_size && draw.next(d);)
+    drawn.push_back(d);
+  Thresholds th = fixedThresholds(user_params);
+  const bool estimate = th.sigma_px <= 0.0;
+  double membership_sigmas = user_params.inlier_threshold_sigma;
+  if (estimate) {
+    const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params);
+    const double sigma = s.inliers > 0 ? s.sigma_px : user_params.noise.max_sigma_px;
+    membership_sigmas = membershipSigmas(s.tail_ratio, user_params);
+    th = {sigma, sigma * membership_sigmas};
+  }
+  // With an estimated scale the vote counts the planes' cores (vote_threshold_sigma); each
+  // plane then takes its points within inlier_threshold_sigma of its own scale.
+  const double vote_px = estimate ? th.sigma_px * user_params.vote_threshold_sigma : th.inlier_px;
+  out.noise_px = th.sigma_px;
+  out.threshold_px = th.inlier_px;
+  PlaneParams params = user_params;
+  params.vote_threshold_px = vote_px;
+  params.inlier_threshold_sigma = membership_sigmas;
+  // An outlier costs (threshold / scale)^2: the membership threshold in noise scales.
+  const double k = estimate ? params.inlier_threshold_sigma : params.vote_threshold_sigma;
+  const Energy energy{k * k, th.sigma_px,
+                      params.plane_penalty * std::log(static_cast<double>(view1.size())),
+                      estimate ? 0.0 : th.inlier_px};
+
+  // Paper IV-B with the chosen test, until enough groups pass or the tries run out.
+  const GroupParams& gp = params.groups;
+  const long wanted =
+      std::min<long>(gp.max_groups, static_cast<long>(gp.groups_per_point) * view2.size());
+  const bool transfer = gp.coplanarity_test == "transfer";
+  std::vector<cv::Matx33d> candidates;
+  auto test = [&](const GroupDraw::Drawn& d) {
+    const bool ok = transfer ? d.fifth_error <= gp.transfer_threshold_sigma * th.sigma_px
+                             : isCoplanarGroup(d.group, view1, view2, gp, 0.0);
+    if (!ok) return;
+    const std::vector<int> idx(d.group.begin(), d.group.end());
+    if (auto H = fitHomography(select(view1, idx), select(view2, idx))) {
+      candidates.push_back(*H);
+      out.accepted_groups.push_back(d.group);
+    }
+  };
+  for (size_t i = 0; i < drawn.size() && static_cast<long>(candidates.size()) < wanted; ++i)
+    test(drawn[i]);
+  for (GroupDraw::Drawn d; static_cast<long>(candidates.size()) < wanted && draw.next(d);) test(d);
+  out.groups_built = draw.tried;
+  out.groups_coplanar = static_cast<int>(out.accepted_groups.size());
+
   std::vector<bool> active(view1.size());
   for (size_t i = 0; i < view1.size(); ++i) active[i] = finite(view1[i]) && finite(view2[i]);
 
-  // Paper IV-C repeated: the winner becomes a plane, its points leave the vote.
+  std::optional<cv::Matx33d> F;
+  if (params.epipolar_check) {
+    F = estimateFundamental(view1, view2, th.inlier_px, 0.3, params.groups.seed);
+    out.epipolar_checked = F.has_value();
+  }
+
+  // Paper IV-C repeated: the winner becomes a plane, its points leave the vote, while a
+  // plane pays its label cost.
   std::vector<Plane> planes;
   std::vector<int> bounds(candidates.size(), std::numeric_limits<int>::max());
   while (static_cast<int>(planes.size()) < params.max_planes) {
     Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px, &bounds);
-    if (vote.winner < 0 || vote.votes < params.min_plane_support) break;
+    if (vote.winner < 0 || vote.votes < std::min(5, params.min_plane_support)) break;
     Plane plane;
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
@@ -243,23 +585,79 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
+    if (F && epipolarTransferError(plane.H, *F, view1) >
+                 params.epipolar_threshold_sigma * th.sigma_px) {
+      ++out.rejected_by_epipolar;
+      continue;
+    }
+    // Its own noise scale (estimated ones only; a fixed threshold is every plane's), and
+    // its points under its own threshold.
+    plane.noise_px = th.sigma_px;
+    plane.threshold_px = th.inlier_px;
+    setPlaneNoise(plane, view1, view2, active, energy, params);
+    PlaneParams own = params;
+    own.vote_threshold_px = plane.threshold_px;
+    if (!refitPlane(plane.H, plane.inliers, view1, view2, active, own) ||
+        static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
+      continue;
+    }
+    double gain = -energy.plane_cost;
+    for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i]);
+    if (gain <= 0.0) break;  // the best left does not pay for itself: neither will the rest
     for (int i : plane.inliers) active[i] = false;
     planes.push_back(std::move(plane));
   }
-  refineAssignment(planes, view1, view2, params);
-  mergeSamePlanes(planes, view1, view2, params);
-  refineAssignment(planes, view1, view2, params);
+  refineAssignment(planes, view1, view2, params, energy);
+  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, F);
+  refineAssignment(planes, view1, view2, params, energy);
+  mergeSamePlanes(planes, view1, view2, params, energy);
+  refineAssignment(planes, view1, view2, params, energy);
   std::stable_sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) {
     return a.inliers.size() > b.inliers.size();
   });
-  for (size_t k = 0; k < planes.size(); ++k) {
-    Plane& p = planes[k];
-    for (int i : p.inliers) out.labels[i] = static_cast<int>(k) + 1;
-    p.rms_error_px = rmsError(p.H, p.inliers, view1, view2);
-    p.score = static_cast<double>(p.inliers.size()) / view1.size();
+  for (size_t p = 0; p < planes.size(); ++p) {
+    Plane& plane = planes[p];
+    for (int i : plane.inliers) out.labels[i] = static_cast<int>(p) + 1;
+    plane.rms_error_px = rmsError(plane.H, plane.inliers, view1, view2);
+    plane.score = static_cast<double>(plane.inliers.size()) / view1.size();
   }
   out.planes = std::move(planes);
   return out;
+}
+
+}  // namespace
+
+PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
+                                const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
+  PlaneSegmentation out;
+  if (view1.size() != view2.size()) {
+    out.error = "the two views have different numbers of points";
+    return out;
+  }
+  out.error = checkPlaneParams(params);
+  if (!out.error.empty()) {
+    out.labels.assign(view1.size(), 0);
+    return out;
+  }
+  std::vector<int> dup_of;
+  const std::vector<int> keep = uniqueCorrespondences(view1, view2, dup_of);
+  if (keep.size() == view1.size()) return segmentUnique(view1, view2, params);
+  PlaneSegmentation u = segmentUnique(select(view1, keep), select(view2, keep), params);
+  // Back to the caller's indices; a repeat gets its first copy's label.
+  std::vector<int> labels(view1.size(), 0), back(view1.size(), -1);
+  for (size_t j = 0; j < keep.size(); ++j) back[keep[j]] = static_cast<int>(j);
+  for (size_t i = 0; i < view1.size(); ++i) labels[i] = u.labels[back[dup_of[i]]];
+  for (Plane& p : u.planes) {
+    std::vector<int> idx;
+    for (size_t i = 0; i < view1.size(); ++i)
+      if (labels[i] > 0 && &u.planes[labels[i] - 1] == &p) idx.push_back(static_cast<int>(i));
+    p.inliers = std::move(idx);
+  }
+  for (PointGroup& g : u.accepted_groups)
+    for (int& i : g) i = keep[i];
+  u.labels = std::move(labels);
+  u.duplicates = static_cast<int>(view1.size() - keep.size());
+  return u;
 }
 
 }  // namespace mono_plane_detection

@@ -21,8 +21,9 @@ namespace {
 
 void printJson(const PlaneSegmentation& result, size_t points) {
   std::printf(
-      "{\n  \"points\": %zu,\n  \"groups_built\": %d,\n  \"groups_coplanar\": %d,\n  \"planes\": [",
-      points, result.groups_built, result.groups_coplanar);
+      "{\n  \"points\": %zu,\n  \"noise_px\": %.6f,\n  \"threshold_px\": %.6f,\n"
+      "  \"groups_built\": %d,\n  \"groups_coplanar\": %d,\n  \"planes\": [",
+      points, result.noise_px, result.threshold_px, result.groups_built, result.groups_coplanar);
   for (size_t k = 0; k < result.planes.size(); ++k) {
     const Plane& p = result.planes[k];
     std::printf(
@@ -62,8 +63,21 @@ int main(int argc, char** argv) {
             "plane parameters of config/planes.yaml with the overlay of profile P (default, "
             "wheeled, humanoid) or a .yaml file over it; none: the core's defaults",
             "P")
-      .number("threshold", &params.vote_threshold_px, 1e-3, 1e3,
-              "transfer error for a point to vote / belong, pixels", "PX")
+      .number("threshold", &params.vote_threshold_px, 0.0, 1e3,
+              "transfer error for a point to vote / belong, pixels; 0 = estimate the noise "
+              "scale from the data (default)", "PX")
+      .number("inlier-sigmas", &params.inlier_threshold_sigma, 0.5, 50.0,
+              "with --threshold 0: a point belongs within this many noise scales", "K")
+      .number("vote-sigmas", &params.vote_threshold_sigma, 0.5, 50.0,
+              "with --threshold 0: the vote counts within this many noise scales", "K")
+      .number("transfer-sigmas", &params.groups.transfer_threshold_sigma, 0.1, 1000.0,
+              "transfer coplanarity test: fifth point within this many noise scales", "K")
+      .number("plane-penalty", &params.plane_penalty, 0.0, 1000.0,
+              "model selection: a plane costs this x ln(points) squared noise scales", "P")
+      .choice("coplanarity-test", &params.groups.coplanarity_test, {"transfer", "cross_ratio"},
+              "five-point coplanarity test")
+      .flag("epipolar-check", &params.epipolar_check,
+            "reject homographies not induced by a plane of the estimated F")
       .integer("max-planes", &params.max_planes, 1, 1000, "at most K planes", "K")
       .integer("min-support", &params.min_plane_support, 4, 1000000,
                "a plane needs at least N points")

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "mono_plane_detection/planes/coplanar_groups.h"
@@ -104,4 +105,58 @@ TEST(CoplanarGroups, FindStopsAtTheCapAndCountsTries) {
   EXPECT_LE(found.tried, params.max_tries);
   for (const auto& g : found.groups)
     EXPECT_TRUE(isCoplanarGroup(g, scene.view1, scene.view2, params));
+}
+
+// The transfer test: the fifth point's error under the other four's homography is 0 on a
+// plane and grows with the point's distance from it; in noise units it accepts coplanar
+// groups and refuses off-plane ones.
+TEST(CoplanarGroups, FifthPointErrorAndTheTransferTest) {
+  const cv::Matx33d H(1.05, 0.02, 12, -0.03, 0.98, -7, 1e-4, 5e-5, 1);
+  auto apply = [&](const cv::Point2d& p) {
+    const cv::Vec3d q = H * cv::Vec3d(p.x, p.y, 1);
+    return cv::Point2d(q[0] / q[2], q[1] / q[2]);
+  };
+  std::vector<cv::Point2d> v1{{100, 100}, {300, 120}, {280, 320}, {90, 300}, {200, 210}};
+  std::vector<cv::Point2d> v2;
+  for (const auto& p : v1) v2.push_back(apply(p));
+  const PointGroup g{0, 1, 2, 3, 4};
+  EXPECT_LT(fifthPointError(g, v1, v2), 1e-9);
+  v2[4].x += 3.0;  // the fifth point 3 px off the plane
+  EXPECT_NEAR(fifthPointError(g, v1, v2), 3.0, 1e-9);
+  GroupParams params;  // transfer, 10 noise scales
+  EXPECT_TRUE(isCoplanarGroup(g, v1, v2, params, 0.5));    // 3 px < 5 px
+  EXPECT_FALSE(isCoplanarGroup(g, v1, v2, params, 0.25));  // 3 px > 2.5 px
+  // Without a noise scale the paper's cross-ratio test decides.
+  params.coplanarity_test = "cross_ratio";
+  EXPECT_EQ(isCoplanarGroup(g, v1, v2, params, 0.5), isCoplanarGroup(g, v1, v2, params, 0.0));
+  // Degenerate four: infinite error.
+  std::vector<cv::Point2d> line{{0, 0}, {1, 1}, {2, 2}, {3, 3}, {5, 1}};
+  EXPECT_TRUE(std::isinf(fifthPointError(g, line, line)));
+  EXPECT_TRUE(knownCoplanarityTest("transfer"));
+  EXPECT_TRUE(knownCoplanarityTest("cross_ratio"));
+  EXPECT_FALSE(knownCoplanarityTest("Transfer"));
+}
+
+// On a synthetic pair both tests accept mostly groups of one plane.
+TEST(CoplanarGroups, BothTestsKeepMostlySinglePlaneGroups) {
+  TwoViewSceneParams sp;
+  sp.planes = 3;
+  sp.outlier_fraction = 0.3;
+  sp.noise_px = 0.5;
+  const auto scene = makeTwoViewScene(sp);
+  for (const char* test : {"transfer", "cross_ratio"}) {
+    GroupParams params;
+    params.coplanarity_test = test;
+    const CoplanarGroups found =
+        findCoplanarGroups(scene.view1, scene.view2, params, std::sqrt(2.0) * sp.noise_px);
+    ASSERT_GT(found.groups.size(), 50u) << test;
+    int pure = 0;
+    for (const PointGroup& g : found.groups) {
+      const int l = scene.labels[g[0]];
+      bool same = l > 0;
+      for (int i : g) same = same && scene.labels[i] == l;
+      pure += same;
+    }
+    EXPECT_GT(static_cast<double>(pure) / found.groups.size(), 0.8) << test;
+  }
 }

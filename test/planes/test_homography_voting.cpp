@@ -1,7 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
 #include <limits>
+#include <string>
+#include <tuple>
 
+#include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
@@ -79,6 +84,7 @@ TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {
   sp.outlier_fraction = 0.3;
   const auto scene = makeTwoViewScene(sp);
   PlaneParams params;
+  params.vote_threshold_px = 2.0;  // refitPlane takes the threshold as given
   cv::Matx33d H = scene.homographies[0] * shift(1.2);  // off by 1.2 px
   std::vector<int> inliers = inliersOf(H, scene.view1, scene.view2, {}, params.vote_threshold_px);
   ASSERT_TRUE(refitPlane(H, inliers, scene.view1, scene.view2, {}, params));
@@ -179,4 +185,111 @@ TEST(SegmentPlanes, DegenerateInputs) {
   EXPECT_EQ(r.labels[3], 0);
   EXPECT_EQ(r.labels[5], 0);
   EXPECT_EQ(r.planes.size(), 1u);
+}
+
+TEST(SegmentPlanes, ThresholdsFixedOrEstimated) {
+  PlaneParams params;
+  EXPECT_EQ(fixedThresholds(params).sigma_px, 0.0);  // default: estimated
+  params.vote_threshold_px = 2.0;
+  EXPECT_DOUBLE_EQ(fixedThresholds(params).inlier_px, 2.0);
+  EXPECT_DOUBLE_EQ(fixedThresholds(params).sigma_px, 2.0 / params.vote_threshold_sigma);
+  EXPECT_TRUE(checkPlaneParams(params).empty());
+  params.groups.coplanarity_test = "cross-ratio";
+  EXPECT_FALSE(checkPlaneParams(params).empty());
+  const auto r = segmentPlanes({{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 3}}, {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 3}}, params);
+  EXPECT_NE(r.error.find("coplanarity_test"), std::string::npos);
+  EXPECT_EQ(r.labels, std::vector<int>(5, 0));
+}
+
+// The estimated noise scale follows the data: synthetic pairs at 0.3 and 1 px noise per
+// view give transfer scales near sqrt(2) x that, and the planes are recovered.
+TEST(SegmentPlanes, EstimatesTheNoiseScaleOfThePair) {
+  for (double noise : {0.3, 1.0}) {
+    TwoViewSceneParams sp;
+    sp.planes = 2;
+    sp.noise_px = noise;
+    sp.outlier_fraction = 0.3;
+    const auto scene = makeTwoViewScene(sp);
+    const auto r = segmentPlanes(scene.view1, scene.view2);
+    EXPECT_NEAR(r.noise_px, std::sqrt(2.0) * noise, 0.4 * noise) << noise;
+    EXPECT_EQ(r.planes.size(), 2u) << noise;
+    EXPECT_LT(misclassificationError(scene.labels, r.labels), 0.08) << noise;
+    for (const Plane& p : r.planes) EXPECT_GE(p.noise_px, r.noise_px);
+  }
+}
+
+// A repeated correspondence counts once and gets its first copy's label.
+TEST(SegmentPlanes, DuplicatesCountOnce) {
+  TwoViewSceneParams sp;
+  sp.planes = 2;
+  const auto scene = makeTwoViewScene(sp);
+  auto v1 = scene.view1, v2 = scene.view2;
+  const auto once = segmentPlanes(v1, v2);
+  const size_t n = v1.size();
+  for (size_t k = 0; k < 40; ++k) {  // three points repeated 40 times would weigh 14 times
+    v1.push_back(v1[n - 1 - k % 3]);
+    v2.push_back(v2[n - 1 - k % 3]);
+  }
+  const auto twice = segmentPlanes(v1, v2);
+  EXPECT_EQ(twice.duplicates, 40);
+  ASSERT_EQ(twice.labels.size(), v1.size());
+  EXPECT_EQ(std::vector<int>(twice.labels.begin(), twice.labels.begin() + once.labels.size()),
+            once.labels);
+  for (size_t k = 0; k < 40; ++k) EXPECT_EQ(twice.labels[n + k], twice.labels[n - 1 - k % 3]);
+  for (const Plane& p : twice.planes)
+    for (int i : p.inliers) EXPECT_EQ(twice.labels[i], &p - &twice.planes[0] + 1);
+}
+
+namespace {
+
+struct RealScene {
+  std::vector<cv::Point2d> view1, view2;
+  std::vector<int> labels;
+};
+
+RealScene readScene(const std::string& name) {
+  RealScene s;
+  std::ifstream txt(std::string(TEST_DATA_DIR) + "/" + name + ".txt");
+  const Correspondences c = readCorrespondences(txt);
+  s.view1 = c.view1;
+  s.view2 = c.view2;
+  std::ifstream labels(std::string(TEST_DATA_DIR) + "/" + name + ".labels");
+  std::string line;
+  while (std::getline(labels, line)) {
+    line = line.substr(0, line.find('#'));
+    if (line.find_first_not_of(" \t\r") != std::string::npos) s.labels.push_back(std::stoi(line));
+  }
+  return s;
+}
+
+}  // namespace
+
+// Real images, default settings, five seeds: AdelaideRMF sene (2 planes, 47 % outliers)
+// and elderhallb (3 planes, 48 % outliers). Measured: sene 2.8-3.6 % (the paper's fixed
+// 2 px: 6.4 %), elderhallb 6.4 % mean over seeds 1-5, worst 9.8 % (7.4 % over 20 seeds,
+// worst 14 %: two of its planes meet at a shallow angle; fixed 2 px: 8.2 %, worst 12.6 %).
+TEST(SegmentPlanes, RealScenesBelowAMisclassificationBound) {
+  for (const auto& [name, mean_bound, worst_bound] :
+       {std::make_tuple("adelaidermf_sene", 0.04, 0.05),
+        std::make_tuple("adelaidermf_elderhallb", 0.075, 0.11)}) {
+    const RealScene s = readScene(name);
+    ASSERT_EQ(s.labels.size(), s.view1.size()) << name;
+    ASSERT_GT(s.view1.size(), 200u) << name;
+    double sum = 0, worst = 0;
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+      PlaneParams params;
+      params.groups.seed = seed;
+      const double e = misclassificationError(s.labels, segmentPlanes(s.view1, s.view2, params).labels);
+      sum += e / 5;
+      worst = std::max(worst, e);
+    }
+    std::printf("%s: mean %.2f %%, worst %.2f %% over 5 seeds\n", name, 100 * sum, 100 * worst);
+    EXPECT_LT(sum, mean_bound) << name;
+    EXPECT_LT(worst, worst_bound) << name;
+  }
+  // The paper's fixed 2 px on sene, for comparison: worse than the estimate.
+  const RealScene s = readScene("adelaidermf_sene");
+  PlaneParams fixed;
+  fixed.vote_threshold_px = 2.0;
+  EXPECT_GT(misclassificationError(s.labels, segmentPlanes(s.view1, s.view2, fixed).labels), 0.04);
 }

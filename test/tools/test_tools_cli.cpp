@@ -21,7 +21,8 @@ const std::vector<std::pair<std::string, std::string>> kTools = {
     {"benchmark_tracker", BENCHMARK_TRACKER_PATH}, {"demo_report", DEMO_REPORT_PATH},
     {"detect_target", DETECT_TARGET_PATH},
     {"make_sequence", MAKE_SEQUENCE_PATH},         {"run_pipeline", RUN_PIPELINE_PATH},
-    {"segment_planes", SEGMENT_PLANES_PATH},       {"benchmark_tracker_floor", BENCHMARK_TRACKER_FLOOR_PATH}};
+    {"segment_planes", SEGMENT_PLANES_PATH},       {"benchmark_tracker_floor", BENCHMARK_TRACKER_FLOOR_PATH},
+    {"eval_two_view", EVAL_TWO_VIEW_PATH},         {"plane_pair", PLANE_PAIR_PATH}};
 
 // No master on port 1: a program that tried to reach one would wait; `timeout` ends it.
 ProgramRun run(const std::string& path, const std::string& args) {
@@ -56,6 +57,13 @@ TEST(ToolsCli, UnreadableInputsExitTwo) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("cannot read"), std::string::npos) << r.err;
   r = run(DEMO_REPORT_PATH, "--truth /no/such/truth.yaml");
+  EXPECT_EQ(r.code, 2) << r.err;
+  r = run(EVAL_TWO_VIEW_PATH, "/no/such/folder");
+  EXPECT_EQ(r.code, 2) << r.err;
+  r = run(PLANE_PAIR_PATH, "/no/such/a.png /no/such/b.png --fx 500 --fy 500 --cx 320 --cy 240");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("cannot read image"), std::string::npos) << r.err;
+  r = run(PLANE_PAIR_PATH, "/no/such/a.png /no/such/b.png");  // no intrinsics
   EXPECT_EQ(r.code, 2) << r.err;
 }
 

@@ -6,6 +6,7 @@
 #include <array>
 #include <opencv2/core.hpp>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace mono_plane_detection {
@@ -16,13 +17,19 @@ struct GroupParams {
   int max_groups = 300;      // coplanar groups kept per image, so the cost stays bounded
   int groups_per_point = 4;  // fewer points -> fewer groups (max_groups still caps)
   int max_tries = 6000;      // groups tried at most: with many outliers few pass
-  int tries_per_point = 40;  // fewer points -> fewer tries (max_tries still caps)
+  int tries_per_point = 15;  // fewer points -> fewer tries (max_tries still caps) ...
+  int min_tries = 2000;      // ... but few points need as many tries as the paper's 40 / point
   int max_seeds = 2000;      // seed points with a neighbour list (bounds memory)
   int neighbours = 10;       // a group is a seed and 4 of its nearest neighbours
   // Neighbours closer than this to the seed are passed over: the invariants' relative
   // error grows as pixel noise / group spread, and tight groups fail the test by noise.
   double min_neighbour_distance_px = 30.0;
   double min_shape = 0.05;           // triangleShape below this is "collinear" (paper IV-A)
+  // "transfer": the fifth point's transfer error under the homography of the other four
+  // is at most transfer_threshold_sigma noise scales; "cross_ratio": the paper's test,
+  // the invariants agree within invariant_threshold (relative, blind to the noise).
+  std::string coplanarity_test = "transfer";
+  double transfer_threshold_sigma = 10.0;  // a 4-point homography amplifies the noise
   double invariant_threshold = 0.1;  // invariantDistance at most this is "coplanar"
   unsigned seed = 1;                 // random choices are deterministic given the seed
 };
@@ -60,18 +67,35 @@ std::vector<PointGroup> buildGroups(const std::vector<cv::Point2d>& points,
                                     const GroupParams& params, int count);
 
 // Paper IV-A + IV-B: groups tried in GroupSampler's order until min(max_groups,
-// groups_per_point * N) pass isCoplanarGroup or min(max_tries, tries_per_point * N)
-// were tried. A group drawn again is skipped (it would give the same homography).
+// groups_per_point * N) pass isCoplanarGroup or triesFor(params, N) were tried. A group drawn again is skipped (it would give the same homography).
 struct CoplanarGroups {
   std::vector<PointGroup> groups;  // the accepted ones
   int tried = 0;
 };
+// sigma_px: the noise scale the transfer test counts in (segmentPlanes estimates it);
+// 0 or less falls back to the cross-ratio test.
 CoplanarGroups findCoplanarGroups(const std::vector<cv::Point2d>& view1,
-                                  const std::vector<cv::Point2d>& view2, const GroupParams& params);
+                                  const std::vector<cv::Point2d>& view2, const GroupParams& params,
+                                  double sigma_px = 0.0);
 
-// Paper IV-B: the group's invariants in view 1 equal those in view 2 within the
-// threshold. False when either view is degenerate.
+// The coplanarity test params.coplanarity_test names (see GroupParams). Cross ratio
+// (paper IV-B): the group's invariants in view 1 equal those in view 2 within the
+// threshold; false when either view is degenerate. Transfer: fifthPointError is at most
+// transfer_threshold_sigma * sigma_px (cross ratio when sigma_px <= 0).
 bool isCoplanarGroup(const PointGroup& group, const std::vector<cv::Point2d>& view1,
-                     const std::vector<cv::Point2d>& view2, const GroupParams& params);
+                     const std::vector<cv::Point2d>& view2, const GroupParams& params,
+                     double sigma_px = 0.0);
+
+// Transfer error (pixels, in view 2) of the group's fifth point under the homography the
+// first four define; infinity when those four are degenerate in either view.
+double fifthPointError(const PointGroup& group, const std::vector<cv::Point2d>& view1,
+                       const std::vector<cv::Point2d>& view2);
+
+// Groups tried at most for this many points: tries_per_point per point, at least
+// min_tries, at most max_tries.
+long triesFor(const GroupParams& params, size_t points);
+
+// True for the two test names GroupParams::coplanarity_test accepts.
+bool knownCoplanarityTest(const std::string& name);
 
 }  // namespace mono_plane_detection

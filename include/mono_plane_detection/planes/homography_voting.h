@@ -8,18 +8,50 @@
 #include <vector>
 
 #include "mono_plane_detection/planes/coplanar_groups.h"
+#include "mono_plane_detection/planes/noise_scale.h"
 
 namespace mono_plane_detection {
 
+// Every threshold is a number of noise scales (sigma, planes/noise_scale.h), estimated
+// per image pair unless vote_threshold_px fixes it (then sigma = vote_threshold_px /
+// vote_threshold_sigma and every plane uses that threshold). Estimated: the vote counts
+// within vote_threshold_sigma, each plane then gets its own noise scale and takes its
+// points within inlier_threshold_sigma of it. Number of planes, merges and drops: one
+// criterion, the energy sum_points min(r^2 / sigma_plane^2, k^2) + plane_penalty * ln(N)
+// per plane (a Gaussian data cost in the plane's own scale, truncated at k, the membership
+// threshold in noise scales; a BIC-like label cost, 3 x the BIC's 8 parameters because the
+// heavy-tailed residuals make the data cost larger than a Gaussian's, measured on
+// AdelaideRMF). The same criterion adds planes, drops, splits and merges them.
 struct PlaneParams {
   GroupParams groups;
-  double vote_threshold_px = 2.0;  // transfer error to vote (paper: 2 px)
-  int min_plane_support = 8;       // a plane needs at least this many points
-  int max_planes = 8;              // stop after this many
-  int refit_iterations = 4;        // refit on inliers / recompute inliers rounds
-  bool robust_refit = true;        // Cauchy re-weighting in the refit
-  double merge_fraction = 0.8;     // merge when one refit on both explains this share of each
+  double vote_threshold_px = 0.0;       // 0: estimated (inlier_threshold_sigma x noise scale)
+  // Real matches have heavy tails (AdelaideRMF: 90th percentile 3-4 median scales), hence
+  // a wide membership threshold on a median-based scale (docs/plane_core.md).
+  double inlier_threshold_sigma = 8.0;  // a point belongs within this many of its plane's scales
+  double vote_threshold_sigma = 4.0;    // the vote counts within this many of the pair's scales
+  double plane_penalty = 24.0;          // a plane costs this x ln(N) squared noise scales
+  int min_plane_support = 8;            // and needs at least this many points
+  int max_planes = 8;                   // stop after this many
+  int refit_iterations = 4;             // refit on inliers / recompute inliers rounds
+  bool robust_refit = true;             // Cauchy re-weighting in the refit
+  NoiseScaleParams noise;               // the estimate's bounds
+  int noise_pilot_groups = 20;          // candidate first planes the noise scale is taken from
+  // Reject homographies not induced by a plane when a fundamental matrix can be estimated
+  // (planes/epipolar_check.h). Off: it cost accuracy on AdelaideRMF (docs/plane_core.md).
+  bool epipolar_check = false;
+  double epipolar_threshold_sigma = 6.0;  // median epipolar transfer error allowed
 };
+
+// The threshold and noise scale params imply when vote_threshold_px fixes them
+// (sigma = threshold / vote_threshold_sigma); {0, 0} when they are to be estimated.
+struct Thresholds {
+  double sigma_px = 0.0;
+  double inlier_px = 0.0;
+};
+Thresholds fixedThresholds(const PlaneParams& params);
+
+// Empty when params are usable by segmentPlanes, else why not (unknown coplanarity test).
+std::string checkPlaneParams(const PlaneParams& params);
 
 struct Vote {
   int winner = -1;          // index of the winning homography, -1 when none
@@ -54,6 +86,8 @@ struct Plane {
   cv::Matx33d H;              // view 1 pixel -> view 2 pixel
   std::vector<int> inliers;   // indices of the points on the plane, ascending
   double rms_error_px = 0.0;  // transfer error over the inliers
+  double noise_px = 0.0;      // this plane's noise scale (planes differ: texture, distance)
+  double threshold_px = 0.0;  // a point belongs within this (inlier_threshold_sigma x noise_px)
   double score = 0.0;         // share of all points on this plane
 };
 
@@ -63,11 +97,18 @@ struct PlaneSegmentation {
   int groups_built = 0;                     // five-point groups tried (built and tested)
   int groups_coplanar = 0;                  // of those, accepted by the invariant test
   std::vector<PointGroup> accepted_groups;  // those groups (drawn in debug images)
+  double noise_px = 0.0;                    // noise scale used (estimated or implied)
+  double threshold_px = 0.0;                // inlier threshold used
+  int duplicates = 0;                       // repeated correspondences (labelled as their first)
+  bool epipolar_checked = false;            // a fundamental matrix was found and used
+  int rejected_by_epipolar = 0;             // candidate planes it rejected
   std::string error;                        // why nothing could be done (sizes differ, ...)
 };
 
 // Every dominant plane between two views of the same points (view1[i] <-> view2[i]).
-// Fewer than 5 points: no plane, all labels 0. Deterministic given params.groups.seed.
+// Repeated correspondences are removed first (they would count twice) and get their first
+// copy's label. Fewer than 5 points: no plane, all labels 0. Deterministic given
+// params.groups.seed.
 PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
                                 const std::vector<cv::Point2d>& view2,
                                 const PlaneParams& params = PlaneParams());

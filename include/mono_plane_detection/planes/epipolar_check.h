@@ -1,0 +1,30 @@
+// Only plane-induced homographies: a homography H induced by a plane between two views
+// with fundamental matrix F satisfies H^T F + F^T H = 0 (Hartley & Zisserman, 13.1), i.e.
+// H x lies on the epipolar line F x of every point x. A homography that fits points of
+// two planes at once, or of no plane, does not.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+namespace mono_plane_detection {
+
+// F (view 1 -> view 2: x2^T F x1 = 0) by RANSAC with the given threshold, or nothing when
+// there are fewer than 15 points or its inliers are fewer than min_inlier_share of them.
+// (A scene of one plane leaves F undetermined; then F says nothing about H.)
+std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
+                                               const std::vector<cv::Point2d>& view2,
+                                               double threshold_px, double min_inlier_share = 0.3,
+                                               unsigned seed = 1);
+
+// Median over `probe` (view-1 points) of the distance in view 2 between H x and the
+// epipolar line F x, pixels: 0 for a plane-induced H. Infinity when no probe gives one.
+double epipolarTransferError(const cv::Matx33d& H, const cv::Matx33d& F,
+                             const std::vector<cv::Point2d>& probe);
+
+// The algebraic form: || H^T F + F^T H || / (2 || H^T F ||) with H, F at unit norm;
+// 0 when H^T F is skew-symmetric (plane-induced), up to 1.
+double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F);
+
+}  // namespace mono_plane_detection
