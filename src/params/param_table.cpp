@@ -429,12 +429,16 @@ const std::vector<std::string>& planeRuntimeParamNames() {
       "planes/max_planes",
       "planes/refit_iterations",
       "planes/robust_refit",
-      "planes/merge_fraction",
+      "planes/inlier_threshold_sigma",
+      "planes/vote_threshold_sigma",
+      "planes/plane_penalty",
+      "planes/epipolar_check",
       "planes/groups/max_groups",
       "planes/groups/max_tries",
       "planes/groups/min_neighbour_distance_px",
       "planes/groups/min_shape",
       "planes/groups/invariant_threshold",
+      "planes/groups/transfer_threshold_sigma",
   };
   return names;
 }
