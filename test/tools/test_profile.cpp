@@ -77,7 +77,7 @@ TEST(Profile, HumanoidOverlayGivesAllItsKeys) {
   ASSERT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "humanoid",
                           planeNodeParamTable(), planes)
                   .empty());
-  EXPECT_DOUBLE_EQ(planes.pipeline.planes.vote_threshold_px, 2.5);
+  EXPECT_EQ(planes.pipeline.planes.groups.max_groups, 100);  // config/planes.yaml (core: 300)
 }
 
 TEST(Profile, NoneKeepsTheCoreDefaultsAndUnknownProfilesAreNamed) {
