@@ -4,7 +4,7 @@
 #   make test    install deps, build, run every gtest and rostest, print a summary
 #   make build   install deps and build the catkin workspace under build/ws
 #   make bench   the benchmark suite and end-to-end latency (figures, never pass/fail)
-#   make eval    segment_planes on the AdelaideRMF dev scenes (DATA=folder)
+#   make eval    the plane core vs sequential MAGSAC on the AdelaideRMF dev scenes (DATA=folder)
 #   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
 #   make helgrind  data-race check: the nodelets' rostests under helgrind
 #   make fuzz    libFuzzer targets of test/fuzz, FUZZ_SECONDS each (default 60)
@@ -95,7 +95,7 @@ bench: build
 	@[ "$(BENCH_ALL)" != 1 ] || { source $(DEVEL) && rosrun mono_plane_detection benchmark_tracker; }
 
 eval: build
-	@source $(DEVEL) && scripts/eval_two_view $(DATA)
+	@source $(DEVEL) && rosrun mono_plane_detection eval_two_view $(DATA)
 
 # Same sources, a second workspace with sanitizers; runs every gtest binary directly but
 # those CMakeLists.txt hosts in a rostest (add_rostest_gtest): they need a ROS master and

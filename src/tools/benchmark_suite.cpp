@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/scene_renderer.h"

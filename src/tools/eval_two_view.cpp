@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
 
@@ -36,13 +37,6 @@ TEST(SyntheticTwoView, PlanesInduceDistinctHomographies) {
           std::min(nearest_other, transferError(s.homographies[k], s.view1[i], s.view2[i]));
     EXPECT_GT(nearest_other, 3.0);
   }
-}
-
-TEST(MisclassificationError, BestMatchingOfLabels) {
-  EXPECT_DOUBLE_EQ(misclassificationError({0, 1, 1, 2, 2}, {0, 2, 2, 1, 1}), 0.0);  // renamed
-  EXPECT_DOUBLE_EQ(misclassificationError({0, 1, 1, 2, 2}, {0, 1, 1, 1, 1}), 0.4);  // merged
-  EXPECT_DOUBLE_EQ(misclassificationError({0, 0, 1, 1}, {1, 1, 0, 0}), 1.0);  // 0 only matches 0
-  EXPECT_DOUBLE_EQ(misclassificationError({1, 1, 1, 1}, {1, 1, 2, 3}), 0.5);
 }
 
 TEST(BestPossibleLabels, ExactDataIsPerfectNoiseIsNot) {

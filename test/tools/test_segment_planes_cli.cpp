@@ -3,6 +3,7 @@
 
 #include <sstream>
 
+#include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
 #include "support/run_program.h"
 

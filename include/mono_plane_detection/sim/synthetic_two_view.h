@@ -35,8 +35,4 @@ TwoViewScene makeTwoViewScene(const TwoViewSceneParams& params);
 // what noise makes unavoidable (points near where two planes meet).
 std::vector<int> bestPossibleLabels(const TwoViewScene& scene, double threshold_px);
 
-// Share of points whose label is wrong after the best one-to-one matching of found
-// planes to true planes (0 is matched to 0), as in the AdelaideRMF literature.
-double misclassificationError(const std::vector<int>& truth, const std::vector<int>& found);
-
 }  // namespace mono_plane_detection
