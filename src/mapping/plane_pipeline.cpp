@@ -116,7 +116,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       if (result.pairs.ids.size() >= 5) {
         result.segmentation =
             segmentPlanes(result.pairs.first, result.pairs.second, params_.planes);
-        for (const Plane& p : result.segmentation.planes) {
+        for (const HomographyPlane& p : result.segmentation.planes) {
           ImagePlane image_plane;
           image_plane.H = p.H;
           image_plane.rms_error_px = p.rms_error_px;

@@ -44,12 +44,12 @@ struct Energy {
   double sigma;       // the image pair's noise scale
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
-  double point(const Plane& p, const cv::Point2d& a, const cv::Point2d& b) const {
+  double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b) const {
     const double u = transferError(p.H, a, b) / p.noise_px;
     if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
     return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), k2);
   }
-  double sum(const Plane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
+  double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
              const std::vector<cv::Point2d>& view2) const {
     double e = 0.0;
     for (int i : idx) e += point(p, view1[i], view2[i]);
@@ -59,7 +59,7 @@ struct Energy {
 
 // The plane's noise scale from its residuals over the points (medianScale from the
 // image pair's scale, kept within a factor 4 of it), and its threshold.
-void setPlaneNoise(Plane& plane, const std::vector<cv::Point2d>& view1,
+void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1,
                    const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                    const Energy& energy, const PlaneParams& params) {
   std::vector<double> r;
@@ -78,13 +78,13 @@ void setPlaneNoise(Plane& plane, const std::vector<cv::Point2d>& view1,
 // Planes found one after another can be the same physical plane (split by noise):
 // two are merged when the criterion says so: one homography refitted on both costs less
 // than the two, one plane's label cost included. Best merge first, until none pays.
-void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
+void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                      const std::vector<cv::Point2d>& view2, const PlaneParams& params,
                      const Energy& energy) {
   for (;;) {
     double best_gain = 0.0;
     size_t bi = 0, bj = 0;
-    Plane best_plane;
+    HomographyPlane best_plane;
     for (size_t i = 0; i < planes.size(); ++i) {
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
@@ -108,14 +108,14 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
         // alone can stay with its own piece.
-        Plane merged;
+        HomographyPlane merged;
         double together = std::numeric_limits<double>::infinity();
         const auto union_fit = fitHomography(select(view1, both), select(view2, both));
         for (const std::optional<cv::Matx33d>& start :
              {std::optional<cv::Matx33d>(planes[i].H), std::optional<cv::Matx33d>(planes[j].H),
               union_fit}) {
           if (!start) continue;
-          Plane m;
+          HomographyPlane m;
           m.H = *start;
           std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
           if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
@@ -156,7 +156,7 @@ void mergeSamePlanes(std::vector<Plane>& planes, const std::vector<cv::Point2d>&
 // among the plane's points that does not explain nearly all of them, and the best
 // candidate on the rest, each refitted with its own scale; the plane is replaced by the
 // two when their cost plus one more label cost is below its cost.
-void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& candidates,
+void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Matx33d>& candidates,
                  const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                  const PlaneParams& params, const Energy& energy, double vote_px,
                  const std::optional<cv::Matx33d>& F) {
@@ -180,7 +180,7 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
       }
       return best;
     };
-    auto make = [&](int c, const std::vector<bool>& active, Plane& out) {
+    auto make = [&](int c, const std::vector<bool>& active, HomographyPlane& out) {
       out.H = candidates[c];
       out.inliers = inliersOf(out.H, view1, view2, active, vote_px);
       PlaneParams vp = params;
@@ -197,7 +197,7 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
       return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
     };
     const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
-    Plane A, B;
+    HomographyPlane A, B;
     if (a < 0 || !make(a, mine, A)) continue;
     std::vector<bool> rest = mine;
     for (int i : A.inliers) rest[i] = false;
@@ -215,7 +215,7 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
 }
 
 // Every point goes to the plane that explains it at least cost, or to none.
-std::vector<int> assignPoints(const std::vector<Plane>& planes,
+std::vector<int> assignPoints(const std::vector<HomographyPlane>& planes,
                               const std::vector<cv::Point2d>& view1,
                               const std::vector<cv::Point2d>& view2, const Energy& energy) {
   std::vector<int> labels(view1.size(), 0);
@@ -237,7 +237,7 @@ std::vector<int> assignPoints(const std::vector<Plane>& planes,
 // (its points cost less than its label cost more under the other planes or as outliers)
 // or has fewer than min_plane_support points, assigning again each time. Returns each
 // plane's points.
-std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
+std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& planes,
                                                   const std::vector<cv::Point2d>& view1,
                                                   const std::vector<cv::Point2d>& view2,
                                                   const PlaneParams& params, const Energy& energy) {
@@ -269,7 +269,7 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<Plane>& planes,
 // Alternates assigning every point to its best plane and refitting each plane on its
 // points until the labels stop changing: pieces found early, which hold a few points of
 // a neighbouring plane, give those points back. Leaves planes[k].inliers set.
-void refineAssignment(std::vector<Plane>& planes, const std::vector<cv::Point2d>& view1,
+void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                       const std::vector<cv::Point2d>& view2, const PlaneParams& params,
                       const Energy& energy) {
   std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
@@ -572,12 +572,12 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
 
   // Paper IV-C repeated: the winner becomes a plane, its points leave the vote, while a
   // plane pays its label cost.
-  std::vector<Plane> planes;
+  std::vector<HomographyPlane> planes;
   std::vector<int> bounds(candidates.size(), std::numeric_limits<int>::max());
   while (static_cast<int>(planes.size()) < params.max_planes) {
     Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px, &bounds);
     if (vote.winner < 0 || vote.votes < std::min(5, params.min_plane_support)) break;
-    Plane plane;
+    HomographyPlane plane;
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
     bounds[vote.winner] = 0;  // used: never votes again
@@ -612,11 +612,11 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   refineAssignment(planes, view1, view2, params, energy);
   mergeSamePlanes(planes, view1, view2, params, energy);
   refineAssignment(planes, view1, view2, params, energy);
-  std::stable_sort(planes.begin(), planes.end(), [](const Plane& a, const Plane& b) {
+  std::stable_sort(planes.begin(), planes.end(), [](const HomographyPlane& a, const HomographyPlane& b) {
     return a.inliers.size() > b.inliers.size();
   });
   for (size_t p = 0; p < planes.size(); ++p) {
-    Plane& plane = planes[p];
+    HomographyPlane& plane = planes[p];
     for (int i : plane.inliers) out.labels[i] = static_cast<int>(p) + 1;
     plane.rms_error_px = rmsError(plane.H, plane.inliers, view1, view2);
     plane.score = static_cast<double>(plane.inliers.size()) / view1.size();
@@ -647,7 +647,7 @@ PlaneSegmentation segmentPlanes(const std::vector<cv::Point2d>& view1,
   std::vector<int> labels(view1.size(), 0), back(view1.size(), -1);
   for (size_t j = 0; j < keep.size(); ++j) back[keep[j]] = static_cast<int>(j);
   for (size_t i = 0; i < view1.size(); ++i) labels[i] = u.labels[back[dup_of[i]]];
-  for (Plane& p : u.planes) {
+  for (HomographyPlane& p : u.planes) {
     std::vector<int> idx;
     for (size_t i = 0; i < view1.size(); ++i)
       if (labels[i] > 0 && &u.planes[labels[i] - 1] == &p) idx.push_back(static_cast<int>(i));

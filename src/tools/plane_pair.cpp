@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
     std::printf("{\n  \"matches\": %zu,\n  \"noise_px\": %.6f,\n  \"threshold_px\": %.6f,\n  \"planes\": [",
                 ua.size(), result.noise_px, result.threshold_px);
     for (size_t k = 0; k < result.planes.size(); ++k) {
-      const Plane& p = result.planes[k];
+      const HomographyPlane& p = result.planes[k];
       std::printf("%s\n    {\"id\": %zu, \"support\": %zu, \"noise_px\": %.6f, \"rms_error_px\": %.6f,\n"
                   "     \"homography\": [[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g]],\n"
                   "     \"points\": [",
@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
     std::printf("plane_pair: %zu matches, noise scale %.3f px, %zu planes\n", ua.size(),
                 result.noise_px, result.planes.size());
     for (size_t k = 0; k < result.planes.size(); ++k) {
-      const Plane& p = result.planes[k];
+      const HomographyPlane& p = result.planes[k];
       std::printf("  plane %zu: %zu points (%.0f %%), noise %.3f px, rms %.3f px, H = [%.5g %.5g %.5g; %.5g %.5g %.5g; %.5g %.5g %.5g]\n",
                   k + 1, p.inliers.size(), 100 * p.score, p.noise_px, p.rms_error_px, p.H(0, 0), p.H(0, 1),
                   p.H(0, 2), p.H(1, 0), p.H(1, 1), p.H(1, 2), p.H(2, 0), p.H(2, 1), p.H(2, 2));

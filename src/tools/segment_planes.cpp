@@ -25,7 +25,7 @@ void printJson(const PlaneSegmentation& result, size_t points) {
       "  \"groups_built\": %d,\n  \"groups_coplanar\": %d,\n  \"planes\": [",
       points, result.noise_px, result.threshold_px, result.groups_built, result.groups_coplanar);
   for (size_t k = 0; k < result.planes.size(); ++k) {
-    const Plane& p = result.planes[k];
+    const HomographyPlane& p = result.planes[k];
     std::printf(
         "%s\n    {\"id\": %zu, \"support\": %zu, \"score\": %.6f, \"rms_error_px\": %.6f,\n"
         "     \"homography\": [[%.10g, %.10g, %.10g], [%.10g, %.10g, %.10g], [%.10g, %.10g, "

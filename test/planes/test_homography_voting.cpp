@@ -215,7 +215,7 @@ TEST(SegmentPlanes, EstimatesTheNoiseScaleOfThePair) {
     EXPECT_NEAR(r.noise_px, std::sqrt(2.0) * noise, 0.4 * noise) << noise;
     EXPECT_EQ(r.planes.size(), 2u) << noise;
     EXPECT_LT(misclassificationError(scene.labels, r.labels), 0.08) << noise;
-    for (const Plane& p : r.planes) EXPECT_GE(p.noise_px, r.noise_px);
+    for (const HomographyPlane& p : r.planes) EXPECT_GE(p.noise_px, r.noise_px);
   }
 }
 
@@ -237,7 +237,7 @@ TEST(SegmentPlanes, DuplicatesCountOnce) {
   EXPECT_EQ(std::vector<int>(twice.labels.begin(), twice.labels.begin() + once.labels.size()),
             once.labels);
   for (size_t k = 0; k < 40; ++k) EXPECT_EQ(twice.labels[n + k], twice.labels[n - 1 - k % 3]);
-  for (const Plane& p : twice.planes)
+  for (const HomographyPlane& p : twice.planes)
     for (int i : p.inliers) EXPECT_EQ(twice.labels[i], &p - &twice.planes[0] + 1);
 }
 

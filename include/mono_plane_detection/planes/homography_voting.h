@@ -82,7 +82,11 @@ bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv:
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params);
 
-struct Plane {
+// A plane between two views (paper IV): its homography and the points on it. The other
+// plane types: ImagePlane (one image's plane with a stable id, mapping/plane_pipeline.h),
+// MapPlane (metric, in the map, mapping/plane_map.h), PlaneFit (a 3D fit,
+// geometry/plane_fit.h), ScenePlane and TruthPlane (the simulator's and the judge's).
+struct HomographyPlane {
   cv::Matx33d H;              // view 1 pixel -> view 2 pixel
   std::vector<int> inliers;   // indices of the points on the plane, ascending
   double rms_error_px = 0.0;  // transfer error over the inliers
@@ -92,7 +96,7 @@ struct Plane {
 };
 
 struct PlaneSegmentation {
-  std::vector<Plane> planes;                // by support, largest first
+  std::vector<HomographyPlane> planes;                // by support, largest first
   std::vector<int> labels;                  // per point: 0 = no plane, k >= 1 = planes[k-1]
   int groups_built = 0;                     // five-point groups tried (built and tested)
   int groups_coplanar = 0;                  // of those, accepted by the invariant test
