@@ -11,7 +11,10 @@
 
 namespace mono_plane_detection {
 
-std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
+namespace {
+
+// What raw and rectified streams both need: an image size and a finite P.
+std::string sizeAndProjectionError(const sensor_msgs::CameraInfo& info) {
   std::ostringstream why;
   if (info.width == 0 || info.height == 0) {
     why << "image size " << info.width << "x" << info.height << " is empty";
@@ -22,6 +25,14 @@ std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
       why << "P[" << i << "] = " << info.P[i] << " is not finite";
       return why.str();
     }
+  return {};
+}
+
+}  // namespace
+
+std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
+  if (std::string error = sizeAndProjectionError(info); !error.empty()) return error;
+  std::ostringstream why;
   cv::Matx33d K;
   for (int i = 0; i < 9; ++i) K.val[i] = info.K[i];
   // Empty D is "no distortion" (simulators, rectified streams), whatever the model says.
@@ -81,16 +92,7 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
   if (rectified) {
     // image_geometry: rectified pixels are those of P's left 3x3, without distortion
     // (D belongs to the raw image the stream was rectified from).
-    std::ostringstream why;
-    if (info.width == 0 || info.height == 0) {
-      why << "image size " << info.width << "x" << info.height << " is empty";
-      return why.str();
-    }
-    for (int i = 0; i < 12; ++i)
-      if (!std::isfinite(info.P[i])) {
-        why << "P[" << i << "] = " << info.P[i] << " is not finite";
-        return why.str();
-      }
+    if (std::string error = sizeAndProjectionError(info); !error.empty()) return error;
     try {
       image_geometry::PinholeCameraModel model;
       model.fromCameraInfo(info);

@@ -29,54 +29,7 @@
 #include "mono_plane_detection/sim/synthetic_views.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
 
-// Heap allocations of the whole process (OpenCV's included) while counting is on:
-// glibc lets a program replace malloc and friends; these forward to glibc's own.
-extern "C" {
-void* __libc_malloc(size_t);
-void* __libc_calloc(size_t, size_t);
-void* __libc_realloc(void*, size_t);
-void* __libc_memalign(size_t, size_t);
-void __libc_free(void*);
-}
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0};
-std::atomic<long> g_bytes{0};
-inline void count(size_t bytes) {
-  if (g_counting.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    g_bytes.fetch_add(static_cast<long>(bytes), std::memory_order_relaxed);
-  }
-}
-}  // namespace
-extern "C" {
-void* malloc(size_t n) {
-  count(n);
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  count(n * size);
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, size_t n) {
-  count(n);
-  return __libc_realloc(p, n);
-}
-void* memalign(size_t alignment, size_t n) {
-  count(n);
-  return __libc_memalign(alignment, n);
-}
-void* aligned_alloc(size_t alignment, size_t n) {
-  count(n);
-  return __libc_memalign(alignment, n);
-}
-int posix_memalign(void** out, size_t alignment, size_t n) {
-  count(n);
-  *out = __libc_memalign(alignment, n);
-  return *out ? 0 : 12;  // ENOMEM
-}
-void free(void* p) { __libc_free(p); }
-}
+#include "allocation_counter.h"
 
 using namespace mono_plane_detection;
 using Clock = std::chrono::steady_clock;

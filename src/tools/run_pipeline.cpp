@@ -166,14 +166,8 @@ int main(int argc, char** argv) {
       tracker.process(image);
       startup.process(image, tracker);
       const auto t1 = Clock::now();
-      TrackFrame frame;
-      frame.stamp = 1000.0 + t;  // every loop starts over in time: a bag loop
-      frame.size = image.size();
-      for (const TrackedPoint& p : tracker.current()) {
-        frame.ids.push_back(p.id);
-        frame.pixels.emplace_back(p.uv.x, p.uv.y);
-        frame.target_corner.push_back(p.is_target_corner);
-      }
+      // Every loop starts over in time: a bag loop.
+      const TrackFrame frame = trackFrameOf(tracker.current(), 1000.0 + t, image.size());
       const PipelineResult result = pipeline.process(frame);
       const auto t2 = Clock::now();
       track_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();

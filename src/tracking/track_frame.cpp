@@ -7,6 +7,18 @@
 
 namespace mono_plane_detection {
 
+TrackFrame trackFrameOf(const std::vector<TrackedPoint>& points, double stamp, cv::Size size) {
+  TrackFrame frame;
+  frame.stamp = stamp;
+  frame.size = size;
+  for (const TrackedPoint& p : points) {
+    frame.ids.push_back(p.id);
+    frame.pixels.emplace_back(p.uv.x, p.uv.y);
+    frame.target_corner.push_back(p.is_target_corner);
+  }
+  return frame;
+}
+
 std::string validateTrackFrame(const TrackFrame& frame) {
   std::ostringstream why;
   if (frame.size.width <= 0 || frame.size.height <= 0) {

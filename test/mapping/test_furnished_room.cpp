@@ -57,14 +57,7 @@ RoomRun runFurnished(const std::string& path) {
     const cv::Mat image = renderer.render(world_from_camera, 100000u + k);
     tracker.process(image);
     startup.process(image, tracker);
-    TrackFrame frame;
-    frame.stamp = 1000.0 + k / 30.0;
-    frame.size = image.size();
-    for (const TrackedPoint& p : tracker.current()) {
-      frame.ids.push_back(p.id);
-      frame.pixels.emplace_back(p.uv.x, p.uv.y);
-      frame.target_corner.push_back(p.is_target_corner);
-    }
+    const TrackFrame frame = trackFrameOf(tracker.current(), 1000.0 + k / 30.0, image.size());
     const PipelineResult result = pipeline.process(frame);
     const Pose truth = map_from_world * world_from_camera;
     if (k > 0) run.travelled_m += cv::norm(truth.t - last);

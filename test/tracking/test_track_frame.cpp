@@ -65,3 +65,19 @@ TEST(TrackFrame, MatchByIdPairsTheSamePoints) {
   EXPECT_EQ(c.first[1], cv::Point2d(10, 10));
   EXPECT_EQ(c.second[1], cv::Point2d(7, 7));
 }
+
+TEST(TrackFrame, TrackerPointsBecomeAFrame) {
+  std::vector<TrackedPoint> points(2);
+  points[0].id = 7;
+  points[0].uv = {10.5f, 20.25f};
+  points[1].id = 9;
+  points[1].uv = {30, 40};
+  points[1].is_target_corner = true;
+  const TrackFrame f = trackFrameOf(points, 12.5, {640, 480});
+  EXPECT_EQ(f.stamp, 12.5);
+  EXPECT_EQ(f.size, cv::Size(640, 480));
+  EXPECT_EQ(f.ids, (std::vector<std::uint64_t>{7, 9}));
+  EXPECT_EQ(f.pixels[0], cv::Point2d(10.5, 20.25));
+  EXPECT_EQ(f.target_corner, (std::vector<bool>{false, true}));
+  EXPECT_EQ(validateTrackFrame(f), "");
+}

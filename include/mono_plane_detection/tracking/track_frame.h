@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "mono_plane_detection/tracking/feature_tracker.h"
+
 namespace mono_plane_detection {
 
 struct TrackFrame {
@@ -16,6 +18,10 @@ struct TrackFrame {
   std::vector<cv::Point2d> pixels;
   std::vector<bool> target_corner;  // corner of the start-up target
 };
+
+// The tracker's points of one image as a frame (what the tracker nodelet's Tracks message
+// carries), for programs that run tracker and planes in one process.
+TrackFrame trackFrameOf(const std::vector<TrackedPoint>& points, double stamp, cv::Size size);
 
 // Points may lie this far outside the image (sub-pixel refinement at the border).
 constexpr double kTrackBorderMarginPx = 2.0;
