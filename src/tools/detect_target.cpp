@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "profile.h"
 #include "mono_plane_detection/tracking/marker_target.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 
@@ -35,7 +36,12 @@ std::string jsonString(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  TargetParams params;
+  // The tracker's target settings of a profile first, so that options override them.
+  std::string profile = profileArgument(argc, argv, "default");
+  TrackerNodeParams node;
+  const std::vector<std::string> profile_errors =
+      loadProfile(MPD_CONFIG_DIR, "tracker", profile, trackerNodeParamTable(), node);
+  TargetParams params = node.target;
   std::vector<std::string> images;
   bool json = false;
   double focal_px = 0;
@@ -48,6 +54,10 @@ int main(int argc, char** argv) {
       "  'IMAGE: none (reason)'; --json: one array of objects.\n"
       "exit codes: 0 ran (found or not), 2 bad usage or an unreadable image\n");
   cli.positionals("IMAGE", &images, "image files (any format OpenCV reads)")
+      .text("profile", &profile,
+            "target settings of config/tracker.yaml with the overlay of profile P (default, "
+            "wheeled, humanoid) or a .yaml file over it; none: the core's defaults",
+            "P")
       .choice("target-type", &params.target_type, {"sheet", "aruco"}, "which target")
       .number("width-m", &params.width_m, 0.01, 10, "sheet: longer side, metres", "M")
       .number("height-m", &params.height_m, 0.01, 10, "sheet: shorter side, metres", "M")
@@ -59,6 +69,7 @@ int main(int argc, char** argv) {
               "aruco: side of the black square, metres", "M")
       .flag("json", &json, "print JSON");
   if (const auto code = cli.parse(argc, argv)) return *code;
+  if (!profile_errors.empty()) return cli.fail(profile_errors.front());
   if (const std::string error = targetParamsError(params); !error.empty()) return cli.fail(error);
 
   int exit_code = 0;

@@ -121,3 +121,16 @@ TEST(ToolsCli, DetectTargetOnRealPhotos) {
                                         "test1.jpg").code,
             2);
 }
+
+// Every tool that takes parameters reads the nodelets' profiles (--profile, profile.h);
+// an unknown profile is a usage error naming the missing file.
+TEST(ToolsCli, ToolsWithParametersRefuseAnUnknownProfile) {
+  const std::vector<std::pair<std::string, std::string>> tools = {
+      {SEGMENT_PLANES_PATH, "a.txt"}, {RUN_PIPELINE_PATH, ""}, {DETECT_TARGET_PATH, "a.png"},
+      {PLANE_PAIR_PATH, "a.png b.png"}};
+  for (const auto& [path, args] : tools) {
+    const ProgramRun r = run(path, "--profile tracked_vehicle " + args);
+    EXPECT_EQ(r.code, 2) << path << ": " << r.err;
+    EXPECT_NE(r.err.find("no profile"), std::string::npos) << path << ": " << r.err;
+  }
+}
