@@ -4,6 +4,7 @@
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <std_srvs/Empty.h>
 
 #include <map>
 #include <memory>
@@ -43,6 +44,21 @@ class TrackerNodelet : public nodelet::Nodelet {
     tracks_pub_ = nh.advertise<Tracks>("tracks", 10, connect, connect);
     debug_pub_ = it_->advertise("debug_image", 1, connect, connect);
     if (!front_.params().lazy) subscribe();
+    reset_srv_ = pnh.advertiseService("reset", &TrackerNodelet::onReset, this);
+  }
+
+  // ~reset: every track and the start-up target start over (ids keep increasing, so no
+  // listener mistakes a new point for an old one); the counts stay.
+  bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    bool done = false;
+    guard_.run("reset", [&] {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      front_.reset();
+      ++resets_;
+      NODELET_INFO("reset: tracks and the start-up target start over");
+      done = true;
+    });
+    return done;
   }
 
   void subscribe() {
@@ -93,6 +109,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     TrackerOutput out;
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
+      if (first_image_.isZero()) first_image_ = started;
       out = front_.process(msg);
       for (const LogEvent& event : out.warnings) warn(event);
       // Before target_timeout_s: why the target is not seen yet, now and then (after it, a
@@ -139,12 +156,18 @@ class TrackerNodelet : public nodelet::Nodelet {
     const TrackerCounts& c = front_.counts();
     const long exceptions = guard_.count();
     const bool no_target = front_.targetOverdue();
-    const bool warn = c.dropped > 0 || c.camera_switches > 0 || exceptions > 0 || no_target;
+    // Images for a while and no usable camera_info: tracking goes on in pixels, but the
+    // plane nodelet needs it for metres and the target check for the sheet's aspect.
+    const bool no_info = !front_.hasCameraInfo() && !first_image_.isZero() &&
+                         (ros::WallTime::now() - first_image_).toSec() > kCameraInfoGraceS;
+    const bool warn =
+        c.dropped > 0 || c.camera_switches > 0 || exceptions > 0 || no_target || no_info;
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
                    : c.camera_switches > 0 ? "image stream mixes cameras"
                    : c.dropped > 0         ? "images dropped"
+                   : no_info               ? std::string("images but no usable camera_info")
                    : no_target            ? "no start-up target: " + front_.targetReason()
                                            : std::string("tracking"));
     status.add("points tracked", c.tracked_now);
@@ -156,6 +179,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
     status.add("camera_info", front_.hasCameraInfo() ? "ok" : "none or unusable");
+    status.add("resets (total)", resets_);
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
@@ -176,6 +200,10 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::Subscriber info_sub_;
   ros::Publisher tracks_pub_;
   image_transport::Publisher debug_pub_;
+  ros::ServiceServer reset_srv_;
+  ros::WallTime first_image_;  // wall: diagnostics must hold under sim time
+  long resets_ = 0;
+  static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images
 
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // front_ and the log throttles

@@ -4,6 +4,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <std_srvs/Empty.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -455,4 +456,51 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   readTimeoutScale();
   return RUN_ALL_TESTS();
+}
+
+// Issue 14: ~reset starts every track over (ids keep increasing, so no listener takes a
+// new point for an old one), and the reset is counted in diagnostics.
+TEST_F(TrackerNodeletTest, ResetStartsEveryTrackOver) {
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  stamp_ += 1000;  // after every earlier test's stamps
+  TracksConstPtr before;
+  for (int k = 0; k < 5; ++k) before = send(makeImage(view({1.0 * k, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(before);
+  ASSERT_FALSE(before->id.empty());
+  size_t tracked = 0;
+  for (uint8_t f : before->flags) tracked += (f & Tracks::FLAG_TRACKED) != 0;
+  EXPECT_GT(tracked, before->id.size() / 2);
+  const uint64_t newest = *std::max_element(before->id.begin(), before->id.end());
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::call("/tracker/reset", reset));
+  const TracksConstPtr after = send(makeImage(view({5.0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(after);
+  ASSERT_FALSE(after->id.empty());
+  for (size_t i = 0; i < after->id.size(); ++i) {
+    EXPECT_EQ(after->prev_index[i], -1);
+    EXPECT_GT(after->id[i], newest);
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("resets (total)"), 1);
+}
+
+// Issue 14: images and no usable camera_info for more than 5 s: WARN, with the reason.
+TEST_F(TrackerNodeletTest, ImagesWithoutCameraInfoAreAWarning) {
+  ros::Publisher images = nh_.advertise<sensor_msgs::Image>("image_no_info", 10);
+  std::map<uint64_t, TracksConstPtr> got;
+  ros::Subscriber tracks = nh_.subscribe<Tracks>(
+      "tracks_no_info", 10, [&](const TracksConstPtr& m) { got[m->header.stamp.toNSec()] = m; });
+  ASSERT_TRUE(spinUntil([&] { return images.getNumSubscribers() > 0; }, 20.0));
+  DiagnosticsProbe diagnostics(nh_, "tracker_no_info: tracking");
+  const ros::WallTime start = ros::WallTime::now();
+  double stamp = 10;
+  while ((ros::WallTime::now() - start).toSec() < 6.5) {
+    images.publish(makeImage(view({0, 0}), "mono8", stamp += 0.1));
+    spinUntil([] { return false; }, 0.1);
+  }
+  EXPECT_GT(got.size(), 10u);  // tracking goes on in pixels
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(diagnostics.message(), "images but no usable camera_info");
+  EXPECT_EQ(diagnostics.value("camera_info"), "none or unusable");
 }
