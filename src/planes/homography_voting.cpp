@@ -416,6 +416,7 @@ struct GroupDraw {
             const GroupParams& params)
       : view1_(view1), view2_(view2), sampler_(view2, params) {
     max_tries_ = triesFor(params, view2.size());
+    seen_.reserve(static_cast<size_t>(max_tries_));
   }
   bool next(Drawn& d) {
     PointGroup g;

@@ -58,6 +58,8 @@ class GroupSampler {
   std::mt19937 rng_;
   std::vector<int> seeds_;
   std::vector<std::vector<int>> near_;  // per seed slot, empty until visited
+  std::vector<int> by_x_;               // point indices by x (empty: scan all points)
+  std::vector<int> rank_x_;             // each point's position in by_x_
   long draws_ = 0;
   long failures_in_a_row_ = 0;
 };
