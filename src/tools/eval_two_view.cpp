@@ -184,6 +184,8 @@ int main(int argc, char** argv) {
         for (size_t f = 0; f < row.size(); ++f) per += cv::format(f ? " %d" : "%d", row[f]);
         per += "]";
       }
+      per += cv::format(", noise %.3f px, planes' scales", result.noise_px);
+      for (const Plane& plane : result.planes) per += cv::format(" %.3f", plane.noise_px);
     }
     std::vector<int> magsac;
     const double start = cpuMs();
