@@ -75,18 +75,29 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   const auto Tt = normaliser(to);
   if (!Tf || !Tt) return std::nullopt;
 
-  // The normal matrix A^T W A summed over points: fixed-size rank-2 updates, lazily
-  // evaluated, so nothing is allocated (this runs for hundreds of 5-point groups).
-  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
-  Eigen::Matrix<double, 2, 9> rows;
+  // The normal matrix A^T W A summed over points. A point's two DLT rows are
+  // (0, -a, b_y a) and (a, 0, -b_x a) (a, b homogeneous, third coordinate 1), so A^T W A
+  // is made of four 3x3 sums of w a a^T (times 1, b_x, b_y, b_x^2 + b_y^2): a fifth of
+  // the work of summing the 9x9 rank-2 updates (refits run on hundreds of points).
+  Eigen::Matrix3d s0 = Eigen::Matrix3d::Zero(), sx = s0, sy = s0, sr = s0;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
     const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
-    rows << 0, 0, 0, -a.x(), -a.y(), -1, b.y() * a.x(), b.y() * a.y(), b.y(), a.x(), a.y(), 1, 0, 0,
-        0, -b.x() * a.x(), -b.x() * a.y(), -b.x();
     const double w = weights.empty() ? 1.0 : weights[i];
-    normal.noalias() += (w * rows.transpose()).lazyProduct(rows);
+    const Eigen::Matrix3d m = (w * a) * a.transpose();
+    s0 += m;
+    sx += b.x() * m;
+    sy += b.y() * m;
+    sr += (b.x() * b.x() + b.y() * b.y()) * m;
   }
+  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
+  normal.block<3, 3>(0, 0) = s0;
+  normal.block<3, 3>(3, 3) = s0;
+  normal.block<3, 3>(0, 6) = -sx;
+  normal.block<3, 3>(6, 0) = -sx;
+  normal.block<3, 3>(3, 6) = -sy;
+  normal.block<3, 3>(6, 3) = -sy;
+  normal.block<3, 3>(6, 6) = sr;
   const auto smallest = smallestEigenvector(normal);
   if (!smallest) return std::nullopt;
   const Eigen::Matrix<double, 9, 1>& h = *smallest;
