@@ -50,8 +50,8 @@ GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupPa
   std::shuffle(seeds_.begin(), seeds_.end(), rng_);
   seeds_.resize(std::min(seeds_.size(), static_cast<size_t>(std::max(1, params.max_seeds))));
   near_.resize(seeds_.size());
-  // A grid of about 3 points per cell for the neighbour search (non-finite points or
-  // all on one line: plain scans).
+  // A grid of about 3 points per cell on average for the neighbour search (non-finite
+  // points or all on one line: plain scans).
   cv::Point2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
   cv::Point2d hi = -lo;
   for (const auto& q : points) {
@@ -61,8 +61,15 @@ GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupPa
   }
   const double area = (hi.x - lo.x) * (hi.y - lo.y);
   if (!(area > 0.0) || !std::isfinite(area)) return;
+  // Cells no larger than the neighbours' minimum distance: points spread thinly around a
+  // dense cluster (outliers) would otherwise put the cluster in a few crowded cells. At
+  // most 4 N + 64 cells.
   cell_px_ = std::sqrt(3.0 * area / static_cast<double>(points.size()));
-  cell_px_ = std::max({cell_px_, (hi.x - lo.x) / 1024.0, (hi.y - lo.y) / 1024.0});
+  if (params.min_neighbour_distance_px > 0.0)
+    cell_px_ = std::min(cell_px_, params.min_neighbour_distance_px);
+  const double max_cells = 4.0 * static_cast<double>(points.size()) + 64.0;
+  cell_px_ = std::max({cell_px_, std::sqrt(area / max_cells), (hi.x - lo.x) / 1024.0,
+                       (hi.y - lo.y) / 1024.0});
   grid_origin_ = lo;
   cols_ = static_cast<int>((hi.x - lo.x) / cell_px_) + 1;
   rows_ = static_cast<int>((hi.y - lo.y) / cell_px_) + 1;

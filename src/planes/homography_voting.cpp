@@ -170,10 +170,18 @@ void splitPlanes(std::vector<Plane>& planes, const std::vector<cv::Matx33d>& can
     auto best_candidate = [&](const std::vector<bool>& active, size_t max_votes) {
       int best = -1;
       size_t best_votes = 0;
+      std::vector<int> voters;
+      for (int i : members)
+        if (active[i]) voters.push_back(i);
       for (size_t c = 0; c < candidates.size(); ++c) {
-        size_t votes = 0;
-        for (int i : members)
-          votes += active[i] && transfersWithin(candidates[c], view1[i], view2[i], vote_px);
+        // Counting stops once the candidate is over max_votes or cannot beat the best:
+        // the same choice for a fraction of the work.
+        size_t votes = 0, left = voters.size();
+        for (int i : voters) {
+          votes += transfersWithin(candidates[c], view1[i], view2[i], vote_px);
+          --left;
+          if (votes > max_votes || votes + left <= best_votes) break;
+        }
         if (votes > best_votes && votes <= max_votes) {
           best_votes = votes;
           best = static_cast<int>(c);
@@ -317,14 +325,27 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
   auto beats = [&vote](int votes, int h) {
     return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
   };
+  // The active points once, and the count of a homography stops as soon as the points
+  // left cannot make it beat the best so far (then its bound is what it could still reach).
+  std::vector<int> points;
+  points.reserve(view1.size());
+  for (size_t i = 0; i < view1.size(); ++i)
+    if (isActive(active, i)) points.push_back(static_cast<int>(i));
   for (int h : order) {
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
-    int votes = 0;
-    for (size_t i = 0; i < view1.size(); ++i) {
-      if (isActive(active, i) && transfersWithin(homographies[h], view1[i], view2[i], threshold_px))
-        ++votes;
+    int votes = 0, left = static_cast<int>(points.size());
+    bool complete = true;
+    for (int i : points) {
+      votes += transfersWithin(homographies[h], view1[i], view2[i], threshold_px);
+      --left;
+      if (left > 0 && !beats(votes + left, h)) {
+        complete = false;
+        votes += left;  // an upper bound on its count
+        break;
+      }
     }
-    if (vote_bounds) (*vote_bounds)[h] = votes;
+    if (vote_bounds) (*vote_bounds)[h] = std::min((*vote_bounds)[h], votes);
+    if (!complete) continue;
     if (beats(votes, h)) {
       vote.votes = votes;
       vote.winner = h;
