@@ -114,6 +114,10 @@ int main(int argc, char** argv) {
                "core: coplanar groups kept per image pair")
       .integer("tries-per-point", &params.groups.tries_per_point, 1, 100000,
                "core: groups tried per point at most")
+      .integer("pilot-groups", &params.noise_pilot_groups, 1, 1000,
+               "core: candidate first planes the noise scale is taken from")
+      .integer("min-tries", &params.groups.min_tries, 1, 100000,
+               "core: groups tried at least (when points x tries-per-point is fewer)")
       .flag("epipolar-check", &params.epipolar_check,
             "core: reject homographies not induced by a plane of the estimated F")
       .number("magsac-threshold", &magsac_threshold, 0.01, 1e3,
