@@ -194,7 +194,9 @@ TEST(CoplanarGroups, NeighbourListsAreTheNearestOfTheDistanceRow) {
     const auto tenth = row[std::min<size_t>(9, row.size() - 1)];
     for (int k = 1; k < 5; ++k) {
       EXPECT_LE(key(g[k]), tenth) << "seed " << g[0] << " member " << g[k];
-      if (&row == &far) EXPECT_GE(key(g[k]).first, floor2);
+      if (&row == &far) {
+        EXPECT_GE(key(g[k]).first, floor2);
+      }
     }
   }
 }
