@@ -1,6 +1,7 @@
 #include "mono_plane_detection/planes/coplanar_groups.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -49,6 +50,40 @@ GroupSampler::GroupSampler(const std::vector<cv::Point2d>& points, const GroupPa
   std::shuffle(seeds_.begin(), seeds_.end(), rng_);
   seeds_.resize(std::min(seeds_.size(), static_cast<size_t>(std::max(1, params.max_seeds))));
   near_.resize(seeds_.size());
+  // A grid of about 3 points per cell on average for the neighbour search (non-finite
+  // points or all on one line: plain scans).
+  cv::Point2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  cv::Point2d hi = -lo;
+  for (const auto& q : points) {
+    if (!std::isfinite(q.x) || !std::isfinite(q.y)) return;
+    lo = {std::min(lo.x, q.x), std::min(lo.y, q.y)};
+    hi = {std::max(hi.x, q.x), std::max(hi.y, q.y)};
+  }
+  const double area = (hi.x - lo.x) * (hi.y - lo.y);
+  if (!(area > 0.0) || !std::isfinite(area)) return;
+  // Cells no larger than the neighbours' minimum distance: points spread thinly around a
+  // dense cluster (outliers) would otherwise put the cluster in a few crowded cells. At
+  // most 4 N + 64 cells.
+  cell_px_ = std::sqrt(3.0 * area / static_cast<double>(points.size()));
+  if (params.min_neighbour_distance_px > 0.0)
+    cell_px_ = std::min(cell_px_, params.min_neighbour_distance_px);
+  const double max_cells = 4.0 * static_cast<double>(points.size()) + 64.0;
+  cell_px_ = std::max({cell_px_, std::sqrt(area / max_cells), (hi.x - lo.x) / 1024.0,
+                       (hi.y - lo.y) / 1024.0});
+  grid_origin_ = lo;
+  cols_ = static_cast<int>((hi.x - lo.x) / cell_px_) + 1;
+  rows_ = static_cast<int>((hi.y - lo.y) / cell_px_) + 1;
+  auto cellOf = [this](const cv::Point2d& q) {
+    const int cx = std::min(cols_ - 1, static_cast<int>((q.x - grid_origin_.x) / cell_px_));
+    const int cy = std::min(rows_ - 1, static_cast<int>((q.y - grid_origin_.y) / cell_px_));
+    return cy * cols_ + cx;
+  };
+  cell_start_.assign(static_cast<size_t>(cols_) * rows_ + 1, 0);
+  for (const auto& q : points) ++cell_start_[cellOf(q) + 1];
+  for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+  cell_points_.resize(points.size());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (size_t j = 0; j < points.size(); ++j) cell_points_[fill[cellOf(points[j])]++] = static_cast<int>(j);
 }
 
 std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
@@ -58,17 +93,46 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   const size_t k = static_cast<size_t>(std::min(std::max(params_.neighbours, 4), n - 1));
   const int seed = seeds_[slot];
   const cv::Point2d& a = points_[seed];
-  // One scan of the seed's row of the distance matrix (squared: same order), keeping
-  // the k nearest at the floor distance or more in a short sorted list.
+  // The k nearest at the floor distance or more (squared distances: same order; ties by
+  // index) in a short sorted list, searched on the grid: the same list as one scan of
+  // the seed's row of the distance matrix, which took up to a quarter of the plane stage.
   auto nearest = [&](double floor2) {
     std::vector<std::pair<double, int>> best;
     best.reserve(k + 1);
-    for (int j = 0; j < n; ++j) {
+    auto consider = [&](int j) {
       const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
       const double d2 = dx * dx + dy * dy;
-      if (j == seed || d2 < floor2 || (best.size() == k && d2 >= best.back().first)) continue;
-      best.insert(std::upper_bound(best.begin(), best.end(), std::make_pair(d2, j)), {d2, j});
+      const std::pair<double, int> key(d2, j);
+      if (j == seed || d2 < floor2 || (best.size() == k && !(key < best.back()))) return;
+      best.insert(std::upper_bound(best.begin(), best.end(), key), key);
       if (best.size() > k) best.pop_back();
+    };
+    if (cell_start_.empty()) {
+      for (int j = 0; j < n; ++j) consider(j);
+      return best;
+    }
+    // Rings of cells around the seed's cell: after ring q every point nearer than q
+    // cells is considered, so the search stops once the k-th distance is below that.
+    const int cx = std::min(cols_ - 1, static_cast<int>((a.x - grid_origin_.x) / cell_px_));
+    const int cy = std::min(rows_ - 1, static_cast<int>((a.y - grid_origin_.y) / cell_px_));
+    const int max_ring = std::max({cx, cols_ - 1 - cx, cy, rows_ - 1 - cy});  // whole grid
+    for (int q = 0; q <= max_ring; ++q) {
+      auto visit = [&](int x, int y) {
+        if (x < 0 || x >= cols_ || y < 0 || y >= rows_) return;
+        const int c = y * cols_ + x;
+        for (int m = cell_start_[c]; m < cell_start_[c + 1]; ++m) consider(cell_points_[m]);
+      };
+      const int x0 = std::max(0, cx - q), x1 = std::min(cols_ - 1, cx + q);
+      for (int x = x0; x <= x1; ++x) {  // top and bottom rows of the ring
+        visit(x, cy - q);
+        if (q > 0) visit(x, cy + q);
+      }
+      for (int y = std::max(0, cy - q + 1); y <= std::min(rows_ - 1, cy + q - 1); ++y) {
+        visit(cx - q, y);  // its left and right columns
+        if (q > 0) visit(cx + q, y);
+      }
+      const double reach = q * cell_px_;
+      if (best.size() == k && best.back().first <= reach * reach) break;
     }
     return best;
   };

@@ -9,8 +9,11 @@
 
 namespace mono_plane_detection {
 
-NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_dof,
-                     double stop_sigmas) {
+namespace {
+
+// msseScale, also giving the largest inlier residual (the inlier set's cut).
+NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model_dof,
+                       double stop_sigmas, double* cut) {
   residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
                                  [](double r) { return !std::isfinite(r); }),
                   residuals.end());
@@ -35,11 +38,20 @@ NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_d
     sum += residuals[k - 1] * residuals[k - 1];
     if (k < min_inliers) continue;
     const double sigma = std::sqrt(sum / (2.0 * k - model_dof));
+    *cut = residuals[k - 1];
     if (k == n) return {sigma, k};
     ensure(k);
     if (residuals[k] > stop_sigmas * sigma) return {sigma, k};
   }
   return {};
+}
+
+}  // namespace
+
+NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_dof,
+                     double stop_sigmas) {
+  double cut = 0.0;
+  return msseWithCut(std::move(residuals), min_inliers, model_dof, stop_sigmas, &cut);
 }
 
 std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
@@ -93,15 +105,16 @@ double asscScore(const NoiseScale& s) {
   return s.inliers > 0 ? s.inliers / (s.sigma_px * s.sigma_px) : 0.0;
 }
 
-// Refits H on the inlier set of `scale` and estimates again while ASSC's score improves.
-NoiseScale refine(cv::Matx33d& H, NoiseScale scale, const std::vector<cv::Point2d>& view1,
-                  const std::vector<cv::Point2d>& view2, const NoiseScaleParams& params) {
+// Refits H on the inlier set of `scale` (residuals r under H, cut: its largest inlier
+// residual) and estimates again while ASSC's score improves. Each round's residuals and
+// cut come from the previous one (recomputing them took a third of the estimate).
+NoiseScale refine(cv::Matx33d& H, NoiseScale scale, std::vector<double> r, double cut,
+                  const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
+                  const NoiseScaleParams& params) {
+  std::vector<cv::Point2d> a, b;
   for (int round = 0; round < 3; ++round) {
-    const std::vector<double> r = transferResiduals(H, view1, view2);
-    std::vector<double> sorted = r;
-    std::nth_element(sorted.begin(), sorted.begin() + (scale.inliers - 1), sorted.end());
-    const double cut = sorted[scale.inliers - 1];
-    std::vector<cv::Point2d> a, b;
+    a.clear();
+    b.clear();
     for (size_t i = 0; i < r.size(); ++i) {
       if (r[i] <= cut) {
         a.push_back(view1[i]);
@@ -110,11 +123,15 @@ NoiseScale refine(cv::Matx33d& H, NoiseScale scale, const std::vector<cv::Point2
     }
     const auto refit = fitHomography(a, b);
     if (!refit) break;
-    const NoiseScale next = msseScale(transferResiduals(*refit, view1, view2),
-                                      params.min_inliers, 8, params.stop_sigmas);
+    std::vector<double> next_r = transferResiduals(*refit, view1, view2);
+    double next_cut = 0.0;
+    const NoiseScale next =
+        msseWithCut(next_r, params.min_inliers, 8, params.stop_sigmas, &next_cut);
     if (asscScore(next) <= asscScore(scale)) break;
     H = *refit;
     scale = next;
+    r = std::move(next_r);
+    cut = next_cut;
   }
   return scale;
 }
@@ -134,10 +151,11 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   NoiseScale best;
   std::optional<cv::Matx33d> best_h;
   for (cv::Matx33d H : candidates) {
-    NoiseScale s =
-        msseScale(transferResiduals(H, view1, view2), params.min_inliers, 8, params.stop_sigmas);
+    std::vector<double> r = transferResiduals(H, view1, view2);
+    double cut = 0.0;
+    NoiseScale s = msseWithCut(r, params.min_inliers, 8, params.stop_sigmas, &cut);
     if (s.inliers == 0 || !(s.sigma_px > 0)) continue;
-    s = refine(H, s, view1, view2, params);
+    s = refine(H, s, std::move(r), cut, view1, view2, params);
     if (asscScore(s) > asscScore(best)) {
       best = s;
       best_h = H;

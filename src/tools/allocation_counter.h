@@ -20,6 +20,12 @@
 #define MPD_OWN_MALLOC 1
 #endif
 
+// The counters exist either way (they stay 0 under AddressSanitizer).
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0}, g_bytes{0};
+}  // namespace
+
 #if MPD_OWN_MALLOC
 extern "C" {
 void* __libc_malloc(size_t);
@@ -29,8 +35,6 @@ void* __libc_memalign(size_t, size_t);
 void __libc_free(void*);
 }
 namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_allocations{0}, g_bytes{0};
 void count(size_t bytes) {
   if (!g_counting.load(std::memory_order_relaxed)) return;
   g_allocations.fetch_add(1, std::memory_order_relaxed);

@@ -115,11 +115,15 @@ int main(int argc, char** argv) {
                "core: coplanar groups kept per image pair")
       .integer("tries-per-point", &params.groups.tries_per_point, 1, 100000,
                "core: groups tried per point at most")
+      .integer("pilot-groups", &params.noise_pilot_groups, 1, 1000,
+               "core: candidate first planes the noise scale is taken from")
+      .integer("min-tries", &params.groups.min_tries, 1, 100000,
+               "core: groups tried at least (when points x tries-per-point is fewer)")
       .flag("epipolar-check", &params.epipolar_check,
             "core: reject homographies not induced by a plane of the estimated F")
       .number("magsac-threshold", &magsac_threshold, 0.01, 1e3,
               "sequential MAGSAC++: its threshold (maximum sigma), pixels", "PX")
-      .flag("per-seed", &per_seed, "print every seed's error");
+      .flag("per-seed", &per_seed, "print every seed's error, groups, true -> found plane counts");
   if (const auto code = cli.parse(argc, argv)) return *code;
 
   std::error_code ec;
@@ -172,7 +176,21 @@ int main(int argc, char** argv) {
       worst = std::max(worst, e);
       noise += result.noise_px / seeds;
       found += static_cast<double>(result.planes.size()) / seeds;
-      per += cv::format(" %.2f", e);
+      per += cv::format("\n    seed %d: %.2f %% (groups %d coplanar of %d tried), true -> found:",
+                        seed, e, result.groups_coplanar, result.groups_built);
+      // Which true plane went where: a split or a merge shows as one row spread over two
+      // columns or two rows in one column.
+      const int true_planes = *std::max_element(s.truth.begin(), s.truth.end());
+      for (int t = 0; t <= true_planes; ++t) {
+        std::vector<int> row(result.planes.size() + 1, 0);
+        for (size_t i = 0; i < s.truth.size(); ++i)
+          if (s.truth[i] == t) ++row[static_cast<size_t>(result.labels[i])];
+        per += cv::format(" %d:[", t);
+        for (size_t f = 0; f < row.size(); ++f) per += cv::format(f ? " %d" : "%d", row[f]);
+        per += "]";
+      }
+      per += cv::format(", noise %.3f px, planes' scales", result.noise_px);
+      for (const HomographyPlane& plane : result.planes) per += cv::format(" %.3f", plane.noise_px);
     }
     std::vector<int> magsac;
     const double start = cpuMs();
@@ -184,7 +202,7 @@ int main(int argc, char** argv) {
     const int planes = *std::max_element(s.truth.begin(), s.truth.end());
     std::printf("%-14s %6zu %6d %6.1f %8.3f %8.2f %8.2f %9.2f %9.2f %9.2f\n", s.name.c_str(),
                 v1.size(), planes, found, noise, err, worst, ms, magsac_err, magsac_ms);
-    if (per_seed) std::printf("  per seed:%s\n", per.c_str());
+    if (per_seed) std::printf("  per seed (outliers are label 0):%s\n", per.c_str());
     sum_err += err;
     sum_ms += ms;
     sum_magsac += magsac_err;

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <set>
 
 #include "mono_plane_detection/planes/coplanar_groups.h"
@@ -158,5 +160,43 @@ TEST(CoplanarGroups, BothTestsKeepMostlySinglePlaneGroups) {
       pure += same;
     }
     EXPECT_GT(static_cast<double>(pure) / found.groups.size(), 0.8) << test;
+  }
+}
+
+// The neighbour lists come from a grid search; every group must still be its seed and 4
+// of the seed's 10 nearest at 30 px or more by (distance, index), as a scan of the seed's
+// row of the distance matrix gives them: a dense cluster among sparse points (crowded
+// cells), integer coordinates with many equal distances, and a cluster all within 30 px.
+TEST(CoplanarGroups, NeighbourListsAreTheNearestOfTheDistanceRow) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> wide(0, 2000), dense(900, 960);
+  std::vector<cv::Point2d> points;
+  for (int i = 0; i < 150; ++i) points.emplace_back(wide(rng), wide(rng));
+  for (int i = 0; i < 300; ++i) points.emplace_back(dense(rng), dense(rng));
+  for (int i = 0; i < 12; ++i) points.emplace_back(3000 + (i % 4) * 5, 3000 + (i / 4) * 5);
+  GroupParams params;
+  const auto groups = buildGroups(points, params, 3000);
+  ASSERT_GT(groups.size(), 1000u);
+  const double floor2 = params.min_neighbour_distance_px * params.min_neighbour_distance_px;
+  for (const auto& g : groups) {
+    auto key = [&](int j) {
+      const cv::Point2d d = points[j] - points[g[0]];
+      return std::make_pair(d.x * d.x + d.y * d.y, j);
+    };
+    std::vector<std::pair<double, int>> far, all;
+    for (int j = 0; j < static_cast<int>(points.size()); ++j) {
+      if (j == g[0]) continue;
+      all.push_back(key(j));
+      if (key(j).first >= floor2) far.push_back(key(j));
+    }
+    std::vector<std::pair<double, int>>& row = far.size() >= 4 ? far : all;
+    std::sort(row.begin(), row.end());
+    const auto tenth = row[std::min<size_t>(9, row.size() - 1)];
+    for (int k = 1; k < 5; ++k) {
+      EXPECT_LE(key(g[k]), tenth) << "seed " << g[0] << " member " << g[k];
+      if (&row == &far) {
+        EXPECT_GE(key(g[k]).first, floor2);
+      }
+    }
   }
 }

@@ -8,6 +8,7 @@
 
 #include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/planes/correspondence_io.h"
+#include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
@@ -76,6 +77,35 @@ TEST(VoteDominant, BoundsGiveTheSameWinnerWithLessWork) {
   int stale = 0;
   for (int b : bounds) stale += b > 0;
   EXPECT_GT(stale, 0);
+}
+
+// The vote stops counting a homography once it cannot win: the winner and its count are
+// still those of counting every point for every homography.
+TEST(VoteDominant, SameWinnerAsCountingEverything) {
+  TwoViewSceneParams sp;
+  sp.planes = 3;
+  sp.outlier_fraction = 0.3;
+  const auto scene = makeTwoViewScene(sp);
+  std::vector<cv::Matx33d> hs;
+  for (int k = 0; k < 60; ++k) hs.push_back(scene.homographies[k % 3] * shift(0.05 * (k % 17)));
+  std::vector<bool> active(scene.view1.size(), true);
+  for (int round = 0; round < 3; ++round) {
+    int best = -1, best_votes = 0;
+    for (size_t h = 0; h < hs.size(); ++h) {
+      int votes = 0;
+      for (size_t i = 0; i < active.size(); ++i)
+        votes += active[i] && transferError(hs[h], scene.view1[i], scene.view2[i]) < 2.0;
+      if (votes > best_votes) {
+        best_votes = votes;
+        best = static_cast<int>(h);
+      }
+    }
+    const Vote vote = voteDominant(hs, scene.view1, scene.view2, active, 2.0);
+    EXPECT_EQ(vote.winner, best);
+    EXPECT_EQ(vote.votes, best_votes);
+    EXPECT_EQ(static_cast<int>(vote.voters.size()), best_votes);
+    for (int i : vote.voters) active[i] = false;
+  }
 }
 
 TEST(RefitPlane, RecoversTheHomographyFromARoughStart) {

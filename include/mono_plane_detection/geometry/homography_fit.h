@@ -35,7 +35,8 @@ inline double transferError(const cv::Matx33d& H, const cv::Point2d& from, const
   if (std::abs(w) < 1e-12) return std::numeric_limits<double>::infinity();
   const double x = (H(0, 0) * from.x + H(0, 1) * from.y + H(0, 2)) / w;
   const double y = (H(1, 0) * from.x + H(1, 1) * from.y + H(1, 2)) / w;
-  return std::hypot(x - to.x, y - to.y);
+  const double dx = x - to.x, dy = y - to.y;
+  return std::sqrt(dx * dx + dy * dy);  // not std::hypot: slow, and pixels do not overflow
 }
 
 }  // namespace mono_plane_detection

@@ -58,6 +58,12 @@ class GroupSampler {
   std::mt19937 rng_;
   std::vector<int> seeds_;
   std::vector<std::vector<int>> near_;  // per seed slot, empty until visited
+  // A uniform grid of the points for the neighbour search (no cells: scan all points).
+  cv::Point2d grid_origin_;
+  double cell_px_ = 0.0;
+  int cols_ = 0, rows_ = 0;
+  std::vector<int> cell_start_;   // cell c holds cell_points_[cell_start_[c] .. cell_start_[c+1])
+  std::vector<int> cell_points_;  // point indices, cell by cell
   long draws_ = 0;
   long failures_in_a_row_ = 0;
 };
