@@ -88,7 +88,7 @@ test: build
 
 # The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
 # through the nodelet manager. BENCH_ALL=1 adds the tracker's per-switch tables.
-# BENCH_DATA: the folder with euroc_stereo/ and tum_office_frames/ (real frames).
+# BENCH_DATA: the folder with euroc_stereo/, tum_office_frames/ and adelaidermf_dev/ (real data).
 BENCH_DATA ?= $(REPO)/../shared/data
 bench: build
 	@source $(DEVEL) && scripts/benchmark.sh $(RESULTS) $(BENCH_DATA)

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # make bench: the benchmark suite (tracker and plane stage against baselines, table and
-# plot), the tracker against the floor on generated and real frames (table and plot),
+# plot), the plane stage on the AdelaideRMF dev scenes against sequential MAGSAC, the
+# tracker against the floor on generated and real frames (table and plot),
 # and the end-to-end latency and resident memory of the nodelet manager (table and
 # plot). Figures, never pass/fail.
 #   scripts/benchmark.sh RESULTS [DATA]   (the workspace sourced; DATA: the folder with
-#   euroc_stereo/ and tum_office_frames/, default ../shared/data next to the repository)
+#   euroc_stereo/, tum_office_frames/ and adelaidermf_dev/, default ../shared/data next to
+#   the repository)
 set -euo pipefail
 results=$1
 data=${2:-$(cd "$(dirname "$0")/.." && pwd)/../shared/data}
@@ -23,6 +25,14 @@ euroc=$(ls "$data"/euroc_stereo/cam0/*.png 2>/dev/null | head -1 || true)
 tum=$(ls "$data"/tum_office_frames/*.png 2>/dev/null | head -1 || true)
 [ -n "$euroc" ] && real+=(--euroc "$euroc") || echo "(no EuRoC images under $data/euroc_stereo: generated rows only)"
 [ -n "$tum" ] && real+=(--tum "$tum") || echo "(no TUM frames under $data/tum_office_frames: generated rows only)"
+# The plane stage on real image pairs: the AdelaideRMF dev scenes against sequential MAGSAC.
+if ls "$data"/adelaidermf_dev/*.labels > /dev/null 2>&1; then
+  echo "== plane stage on real pairs (AdelaideRMF dev scenes) against sequential MAGSAC"
+  rosrun mono_plane_detection eval_two_view "$data/adelaidermf_dev" --seeds 5
+  echo
+else
+  echo "(no AdelaideRMF scenes under $data/adelaidermf_dev: no real-pair plane rows)"
+fi
 echo "== tracker against the floor (glibc malloc defaults)"
 rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor.png"
