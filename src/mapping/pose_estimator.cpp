@@ -91,7 +91,9 @@ void PoseEstimator::reset() {
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
   const auto it = landmarks_.find(id);
-  if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed)) return {};
+  if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed) ||
+      it->second.provisional)
+    return {};
   return it->second.position;
 }
 
@@ -149,6 +151,12 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
     return start;
   }
   std::optional<PoseEstimate> estimate;
+  // The odometry's map is built from odometry poses: while its tf is missing, what vision
+  // adds is provisional (measured: triangulating from those poses put a wall seen only
+  // then 0.24 m off on the rendered wheeled sequence), and started again on its return.
+  const bool was_vision_only = vision_only_;
+  vision_only_ = metric_ == MetricSource::kOdometry && !odom_from_camera;
+  if (was_vision_only && !vision_only_) restartProvisional(frame, normalized, *map_from_odom_ * *odom_from_camera);
   if (odom_from_camera && map_from_odom_)
     estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
   else
@@ -225,6 +233,7 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
             l.triangulated = false;
             l.anchor_pose = map_from_camera;
             l.anchor_normalized = normalized[index[k]];
+            l.provisional = vision_only_;
           }
         }
         PoseEstimate e;
@@ -424,6 +433,7 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[i];
       l.last_seen = frame.stamp;
+      l.provisional = vision_only_;
       continue;
     }
     if (l.fixed) continue;
@@ -439,6 +449,29 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
     l.position = p->x;
     l.triangulated = true;
     l.parallax_deg = parallax;
+    if (vision_only_) l.provisional = true;
+  }
+}
+
+void PoseEstimator::restartProvisional(const TrackFrame& frame,
+                                       const std::vector<cv::Point2d>& normalized,
+                                       const Pose& map_from_camera) {
+  std::unordered_map<std::uint64_t, size_t> in_frame;
+  for (size_t i = 0; i < frame.ids.size(); ++i) in_frame.emplace(frame.ids[i], i);
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    Landmark& l = it->second;
+    const auto seen = in_frame.find(it->first);
+    if (!l.provisional) {
+      ++it;
+    } else if (seen == in_frame.end()) {
+      it = landmarks_.erase(it);
+    } else {
+      l = Landmark();
+      l.anchor_pose = map_from_camera;
+      l.anchor_normalized = normalized[seen->second];
+      l.last_seen = frame.stamp;
+      ++it;
+    }
   }
 }
 

@@ -56,6 +56,10 @@ struct Landmark {
   cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
   double parallax_deg = 0;        // between the two rays of the triangulation
   double last_seen = 0;           // stamp, s
+  // Anchored or triangulated from a vision-only pose while the odometry of an odometry
+  // map was missing: used to place the camera, not given out (landmarkPosition), and
+  // started again from the odometry when it returns.
+  bool provisional = false;
 };
 
 enum class PoseSource { kTarget, kLandmarks, kOdometry };
@@ -93,7 +97,7 @@ class PoseEstimator {
   // comes from the target alone and nothing is triangulated).
   bool initialised() const { return initialised_; }
   const std::unordered_map<std::uint64_t, Landmark>& landmarks() const { return landmarks_; }
-  // Triangulated (or fixed) landmark position of a track, if any.
+  // Triangulated (or fixed) landmark position of a track, if any (not provisional).
   std::optional<cv::Vec3d> landmarkPosition(std::uint64_t id) const;
   // After a pause (tracking loss) the last pose is no guide to the next.
   void forgetLastPose() { last_pose_.reset(); }
@@ -115,6 +119,8 @@ class PoseEstimator {
                            const std::vector<cv::Vec3d>& points_map, double parallax_deg,
                            const Pose& map_from_second);
   bool allows(MetricSource source) const;
+  void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                          const Pose& map_from_camera);
   void forgetOldLandmarks();
 
   struct FirstView {  // the image the two-view start measures motion from
@@ -135,6 +141,7 @@ class PoseEstimator {
   std::unordered_map<std::uint64_t, Landmark> landmarks_;
   std::optional<Pose> last_pose_;
   std::optional<Pose> map_from_odom_;
+  bool vision_only_ = false;  // odometry map, odometry missing for this image
   bool initialised_ = false;
   std::optional<FirstView> first_view_;
   MetricSource metric_ = MetricSource::kNone;
