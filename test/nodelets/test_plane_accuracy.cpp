@@ -7,7 +7,7 @@
 // true camera path on tf (odom -> camera_optical), stopped for 1 s mid-way (the pose
 // must carry on from vision without a jump); camera_height's map has its own origin and
 // heading, so it is judged after the rigid motion (no scale) that best aligns its camera
-// path with the true one.
+// path with the true one. auto: odometry on tf, no target: odometry must be chosen.
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -61,6 +61,8 @@ TEST(PlaneAccuracy, RenderedSequence) {
   spec.frames = 300;
   spec.render.noise_sigma = 2;
   const bool with_target = g_metric_source == "target";
+  // auto with odometry on tf and no target: the odometry must be the one chosen.
+  const std::string source = g_metric_source == "auto" ? "odometry" : g_metric_source;
   if (!with_target) spec.room.target_centre_height_m = 20;  // above the room: never seen
   const std::string base = tempPath("accuracy_" + g_trajectory + "_" + g_metric_source);
   writeSequence(spec, base + ".bag", base + ".yaml");
@@ -111,7 +113,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     const bool tf_stopped = images >= 90 && images < 120;
     // The odometry starts where the robot starts (its origin at the first camera).
     if (truth_pose && !odom_from_truth) odom_from_truth = Pose{cv::Matx33d::eye(), -truth_pose->t};
-    if (g_metric_source == "odometry" && truth_pose && !tf_stopped) {
+    if (source == "odometry" && truth_pose && !tf_stopped) {
       geometry_msgs::TransformStamped tf;
       tf.header.stamp = image->header.stamp;
       tf.header.frame_id = "odom";
@@ -130,7 +132,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     if (last->metric) sources.insert(last->metric_source);
     if (last->metric && truth_pose) {
       cv::Vec3d est = targetFromRosMap(fromPoseMsg(last->camera_pose)).t;
-      if (g_metric_source == "odometry") est = odom_from_truth->inverse().apply(est);
+      if (source == "odometry") est = odom_from_truth->inverse().apply(est);
       position_errors.push_back(cv::norm(est - truth_pose->t));
       est_path.push_back(est);
       true_path.push_back(truth_pose->t);
@@ -144,10 +146,10 @@ TEST(PlaneAccuracy, RenderedSequence) {
   ASSERT_TRUE(last);
 
   std::vector<MapPlane> mapped = mapPlanesOf(*last);
-  if (g_metric_source != "target" && est_path.size() >= 3) {
+  if (source != "target" && est_path.size() >= 3) {
     // The odometry's map is the odometry frame: known. camera_height's is the floor's:
     // the rigid motion that best aligns the camera paths.
-    const Pose truth_from_map = g_metric_source == "odometry"
+    const Pose truth_from_map = source == "odometry"
                                     ? odom_from_truth->inverse()
                                     : rigidAlign(est_path, true_path);
     // The map's up against the truth's (y up in both cores' frames): the alignment
@@ -161,7 +163,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
       p.distance += p.normal.dot(truth_from_map.t);
       for (cv::Vec3d& v : p.polygon) v = truth_from_map.apply(v);
     }
-    if (g_metric_source == "camera_height")
+    if (source == "camera_height")
       for (size_t i = 0; i < est_path.size(); ++i)
         position_errors[i] = cv::norm(truth_from_map.apply(est_path[i]) - true_path[i]);
   }
@@ -192,7 +194,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
   // Image-space planes every image, whatever the metric start does.
   EXPECT_EQ(image_plane_messages, images);
   EXPECT_GE(with_image_planes, images * 9 / 10);
-  EXPECT_EQ(sources, std::set<std::string>{g_metric_source});
+  EXPECT_EQ(sources, std::set<std::string>{source});
   EXPECT_LT(worst_step, 0.1);  // 0.01 m per image: a jump is a failure
 
   EXPECT_TRUE(e.missed.empty()) << e.missed.size() << " plane(s) covering >= 15 % missed";
