@@ -168,7 +168,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     result.status = "no camera intrinsics: image-space planes only";
   } else if (!pose_->scaleKnown()) {
     result.state = PipelineState::kWaitingForTarget;
-    result.status = "waiting for target";
+    result.status = pose_->waitingFor();  // the target, odometry or the floor
   } else if (!pose_->initialised() && !result.pose) {
     result.state = PipelineState::kInitialising;
     result.status = "target seen, initialising: waiting for camera motion (parallax)";

@@ -37,6 +37,41 @@ const char* toString(PoseSource source) {
   return "?";
 }
 
+const char* toString(MetricSource source) {
+  switch (source) {
+    case MetricSource::kNone:
+      return "";
+    case MetricSource::kTarget:
+      return "target";
+    case MetricSource::kOdometry:
+      return "odometry";
+    case MetricSource::kCameraHeight:
+      return "camera_height";
+  }
+  return "?";
+}
+
+std::string metricSourceError(const std::string& choice) {
+  if (choice == "target" || choice == "odometry" || choice == "camera_height" || choice == "auto")
+    return {};
+  return "metric_source '" + choice + "' is not target, odometry, camera_height or auto";
+}
+
+bool PoseEstimator::allows(MetricSource source) const {
+  return params_.metric_source == "auto" || params_.metric_source == toString(source);
+}
+
+std::string PoseEstimator::waitingFor() const {
+  if (metric_ != MetricSource::kNone) return {};
+  std::string what;
+  if (allows(MetricSource::kTarget)) what = "target";
+  if (allows(MetricSource::kOdometry)) what += std::string(what.empty() ? "" : " or ") + "odometry";
+  if (allows(MetricSource::kCameraHeight))
+    what += std::string(what.empty() ? "" : " or ") + "the floor (camera_height" +
+            (floor_reason_.empty() ? "" : ": " + floor_reason_) + ")";
+  return "waiting for " + (what.empty() ? std::string("target") : what);
+}
+
 PoseEstimator::PoseEstimator(const cv::Matx33d& K, const cv::Mat& distortion,
                              const PoseParams& params, const TargetParams& target)
     : K_(K), distortion_(distortion.clone()), params_(params), target_(target) {}
@@ -48,11 +83,17 @@ void PoseEstimator::reset() {
   map_from_odom_.reset();
   initialised_ = false;
   first_view_.reset();
+  metric_ = MetricSource::kNone;
+  floor_reason_.clear();
+  floor_views_.clear();
+  frames_seen_ = 0;
 }
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
   const auto it = landmarks_.find(id);
-  if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed)) return {};
+  if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed) ||
+      it->second.provisional)
+    return {};
   return it->second.position;
 }
 
@@ -66,7 +107,11 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   for (size_t i = 0; i < frame.ids.size(); ++i)
     if (frame.target_corner[i]) corners.push_back(frame.ids[i]);
   std::sort(corners.begin(), corners.end());
-  if (corners.size() == 4 && corners != target_ids_) {
+  // A map started by another source keeps its frame: a target seen later is tracked
+  // like any other points (moving the map to it would move every plane already mapped).
+  const bool target_counts = metric_ == MetricSource::kTarget ||
+                             (metric_ == MetricSource::kNone && allows(MetricSource::kTarget));
+  if (target_counts && corners.size() == 4 && corners != target_ids_) {
     const auto map_corners = targetCornersInMap(target_);
     for (int k = 0; k < 4; ++k) {
       Landmark& l = landmarks_[corners[k]];
@@ -76,12 +121,28 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
       l.last_seen = frame.stamp;
     }
     target_ids_ = corners;
+    if (metric_ == MetricSource::kNone) first_view_.reset();  // a floor start's view
+    metric_ = MetricSource::kTarget;
   }
-  if (target_ids_.empty()) return {};  // no metres without the target
+  if (metric_ == MetricSource::kNone && odom_from_camera && allows(MetricSource::kOdometry)) {
+    // The map is the odometry frame: poses come from it, landmarks are triangulated
+    // between odometry-posed views once they have parallax (triangulate below).
+    metric_ = MetricSource::kOdometry;
+    map_from_odom_ = Pose{};
+    initialised_ = true;
+    first_view_.reset();
+  }
 
   std::vector<cv::Point2d> normalized;
   cv::undistortPoints(frame.pixels, normalized, K_, distortion_);
 
+  if (metric_ == MetricSource::kNone) {
+    if (!allows(MetricSource::kCameraHeight)) return {};  // no metres without a source
+    const std::optional<PoseEstimate> start = startFromFloor(frame, normalized);
+    if (start && odom_from_camera)
+      map_from_odom_ = start->map_from_camera * odom_from_camera->inverse();
+    return start;
+  }
   if (!initialised_) {  // nothing is triangulated before the start
     const std::optional<PoseEstimate> start = initialise(frame, normalized);
     // With odometry, the start fixes where the odometry's origin sits in the map.
@@ -90,6 +151,12 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
     return start;
   }
   std::optional<PoseEstimate> estimate;
+  // The odometry's map is built from odometry poses: while its tf is missing, what vision
+  // adds is provisional (measured: triangulating from those poses put a wall seen only
+  // then 0.24 m off on the rendered wheeled sequence), and started again on its return.
+  const bool was_vision_only = vision_only_;
+  vision_only_ = metric_ == MetricSource::kOdometry && !odom_from_camera;
+  if (was_vision_only && !vision_only_) restartProvisional(frame, normalized, *map_from_odom_ * *odom_from_camera);
   if (odom_from_camera && map_from_odom_)
     estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
   else
@@ -114,7 +181,7 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
   for (size_t i = 0; i < frame.ids.size(); ++i) {
     const auto it = landmarks_.find(frame.ids[i]);
     if (it == landmarks_.end() || !(it->second.triangulated || it->second.fixed)) continue;
-    for (int k = 0; k < 4; ++k)
+    for (size_t k = 0; k < target_ids_.size(); ++k)
       if (frame.ids[i] == target_ids_[k]) target_at[k] = static_cast<int>(i);
     const cv::Vec3d& x = it->second.position;
     object.emplace_back(x[0], x[1], x[2]);
@@ -166,6 +233,7 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
             l.triangulated = false;
             l.anchor_pose = map_from_camera;
             l.anchor_normalized = normalized[index[k]];
+            l.provisional = vision_only_;
           }
         }
         PoseEstimate e;
@@ -242,23 +310,107 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
   const TwoViewInit init =
       initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view, corners);
   if (!init.ok) return {};
-  for (size_t k = 0; k < init.points.size(); ++k) {
-    Landmark& l = landmarks_[ids[init.points[k]]];
+  first_view_.reset();
+  placeStartLandmarks(frame, ids, b, init.points, init.points_map, init.parallax_deg,
+                      init.map_from_second);
+  return PoseEstimate{init.map_from_second, PoseSource::kTarget,
+                      static_cast<int>(init.points.size()), 0};
+}
+
+void PoseEstimator::placeStartLandmarks(const TrackFrame& frame,
+                                        const std::vector<std::uint64_t>& ids,
+                                        const std::vector<cv::Point2d>& second,
+                                        const std::vector<int>& points,
+                                        const std::vector<cv::Vec3d>& points_map,
+                                        double parallax_deg, const Pose& map_from_second) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    Landmark& l = landmarks_[ids[points[k]]];
     l.triangulated = true;
-    l.position = init.points_map[k];
-    l.parallax_deg = init.parallax_deg;
-    l.anchor_pose = init.map_from_second;
-    l.anchor_normalized = b[init.points[k]];
+    l.position = points_map[k];
+    l.parallax_deg = parallax_deg;
+    l.anchor_pose = map_from_second;
+    l.anchor_normalized = second[points[k]];
     l.last_seen = frame.stamp;
   }
   initialised_ = true;
-  first_view_.reset();
-  last_pose_ = init.map_from_second;
-  PoseEstimate e{init.map_from_second, PoseSource::kTarget, static_cast<int>(init.points.size()),
-                 0};
-  triangulate(frame, normalized, init.map_from_second);  // anchors for the other tracks
+  last_pose_ = map_from_second;
+  std::vector<cv::Point2d> normalized;
+  cv::undistortPoints(frame.pixels, normalized, K_, distortion_);
+  triangulate(frame, normalized, map_from_second);  // anchors for the other tracks
   forgetOldLandmarks();
-  return e;
+}
+
+std::optional<PoseEstimate> PoseEstimator::startFromFloor(
+    const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) {
+  std::unordered_map<std::uint64_t, size_t> in_frame;
+  for (size_t i = 0; i < frame.ids.size(); ++i) in_frame.emplace(frame.ids[i], i);
+  // Earlier views that lost most of their tracks are of no more use.
+  auto shared = [&](const FirstView& view) {
+    size_t n = 0;
+    for (auto id : view.ids) n += in_frame.count(id);
+    return n;
+  };
+  while (!floor_views_.empty() && shared(floor_views_.front()) * 2 < floor_views_.front().ids.size())
+    floor_views_.pop_front();
+  const bool keep = frames_seen_++ % 5 == 0;
+  if (floor_views_.empty()) {
+    floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0});
+    floor_reason_ = "waiting for camera motion";
+    return {};
+  }
+  const FirstView& view = floor_views_.front();
+  std::unordered_map<std::uint64_t, size_t> in_first;
+  for (size_t i = 0; i < view.ids.size(); ++i) in_first.emplace(view.ids[i], i);
+  std::vector<cv::Point2d> a, b;
+  std::vector<std::uint64_t> ids;
+  for (size_t i = 0; i < frame.ids.size(); ++i) {
+    const auto it = in_first.find(frame.ids[i]);
+    if (it == in_first.end()) continue;
+    ids.push_back(frame.ids[i]);
+    a.push_back(view.normalized[it->second]);
+    b.push_back(normalized[i]);
+  }
+  if (keep) {
+    floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0});
+    while (floor_views_.size() > 12) floor_views_.pop_front();
+  }
+  const FloorStart floor = floorStart(a, b, K_(0, 0), params_.floor);
+  if (!floor.ok) {
+    floor_reason_ = floor.reason;
+    return {};
+  }
+  // Every track seen in both views, triangulated with the metric motion.
+  const Pose map_from_first = floorMapFromCamera(floor.down, params_.floor.camera_height_m);
+  const Pose map_from_second = map_from_first * floor.second_from_first.inverse();
+  const cv::Matx34d P1 = projectionMatrix(cv::Matx33d::eye(), cv::Vec3d(0, 0, 0));
+  const cv::Matx34d P2 = projectionMatrix(floor.second_from_first.R, floor.second_from_first.t);
+  const double max_error = 2 * params_.floor.max_error_px / K_(0, 0);
+  std::vector<int> points;
+  std::vector<cv::Vec3d> points_map;
+  const cv::Matx33d R21 = floor.second_from_first.R;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    // Each point needs parallax of its own: those near the direction of motion have
+    // none and would put PnP off from the first image on.
+    const cv::Vec3d r1(a[i].x, a[i].y, 1.0), r2 = R21.t() * cv::Vec3d(b[i].x, b[i].y, 1.0);
+    const double parallax = std::acos(std::min(1.0, r1.dot(r2) / cv::norm(r1) / cv::norm(r2))) *
+                            180.0 / CV_PI;
+    if (parallax < params_.min_parallax_deg) continue;
+    const auto p = mono_plane_detection::triangulate(P1, P2, a[i], b[i]);
+    if (!p || p->depth1 < params_.min_depth_m || p->depth2 < params_.min_depth_m ||
+        p->error > max_error)
+      continue;
+    points.push_back(static_cast<int>(i));
+    points_map.push_back(map_from_first.apply(p->x));
+  }
+  if (static_cast<int>(points.size()) < params_.floor.min_inliers) {
+    floor_reason_ = "too few tracks triangulate";
+    return {};
+  }
+  metric_ = MetricSource::kCameraHeight;
+  floor_reason_.clear();
+  floor_views_.clear();
+  placeStartLandmarks(frame, ids, b, points, points_map, floor.parallax_deg, map_from_second);
+  return PoseEstimate{map_from_second, PoseSource::kLandmarks, static_cast<int>(points.size()), 0};
 }
 
 PoseEstimator::FirstView PoseEstimator::firstView(
@@ -281,6 +433,7 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[i];
       l.last_seen = frame.stamp;
+      l.provisional = vision_only_;
       continue;
     }
     if (l.fixed) continue;
@@ -296,6 +449,29 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
     l.position = p->x;
     l.triangulated = true;
     l.parallax_deg = parallax;
+    if (vision_only_) l.provisional = true;
+  }
+}
+
+void PoseEstimator::restartProvisional(const TrackFrame& frame,
+                                       const std::vector<cv::Point2d>& normalized,
+                                       const Pose& map_from_camera) {
+  std::unordered_map<std::uint64_t, size_t> in_frame;
+  for (size_t i = 0; i < frame.ids.size(); ++i) in_frame.emplace(frame.ids[i], i);
+  for (auto it = landmarks_.begin(); it != landmarks_.end();) {
+    Landmark& l = it->second;
+    const auto seen = in_frame.find(it->first);
+    if (!l.provisional) {
+      ++it;
+    } else if (seen == in_frame.end()) {
+      it = landmarks_.erase(it);
+    } else {
+      l = Landmark();
+      l.anchor_pose = map_from_camera;
+      l.anchor_normalized = normalized[seen->second];
+      l.last_seen = frame.stamp;
+      ++it;
+    }
   }
 }
 

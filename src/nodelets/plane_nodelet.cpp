@@ -392,7 +392,15 @@ class PlaneNodelet : public nodelet::Nodelet {
                               "planes only",
                               info_sub_.getTopic().c_str());
       undistortFisheye(frame, camera_);  // equidistant: pinhole pixels of the same K
-      const PipelineResult result = pipeline_->process(frame, odom);
+      // The core's axes (y up) for the odometry: with metric_source odometry the ROS map
+      // is then the odometry frame itself (docs/ros_interface.md).
+      const PipelineResult result =
+          pipeline_->process(frame, odom ? std::optional<Pose>(targetFromRosMap(*odom)) : std::nullopt);
+      const PoseEstimator* estimator = pipeline_->poseEstimator();
+      metric_source_ = estimator ? toString(estimator->metricSource()) : "";
+      // The tf of the odometry source stopped: vision carries the pose (landmarks in the
+      // odometry's frame, so no jump), said in diagnostics.
+      odometry_stopped_ = !odom && !odom_frame_.empty() && metric_source_ == "odometry";
       if (result.was_reset) {
         NODELET_WARN(
             "tracks stamp %.3f is before the previous one: time went backwards (bag "
@@ -426,6 +434,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       map_header.frame_id = map_frame_;
       image_planes = toImagePlanes(msg->header, result);
       planes = toMapPlanes(map_header, result, pipeline_->map());
+      planes->metric_source = image_planes->metric_source = metric_source_;
       if (planes->metric) {
         const Pose ros_map_from_camera = rosMapFromTarget() * result.pose->map_from_camera;
         pose.reset(new geometry_msgs::PoseStamped);
@@ -483,10 +492,15 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
     else if (lost)
       status.summary(DiagnosticStatus::WARN, "tracking lost: " + status_);
+    else if (odometry_stopped_)
+      status.summary(DiagnosticStatus::WARN,
+                     "odometry (" + odom_frame_ + ") stopped: camera pose from vision only");
     else if (target_late)
       status.summary(DiagnosticStatus::WARN,
-                     "start-up target not seen for " + std::to_string(static_cast<int>(waited_s_)) +
-                         " s");
+                     (node_.pipeline.pose.metric_source == "target"
+                          ? "start-up target not seen for "
+                          : "no metric start (" + status_ + ") for ") +
+                         std::to_string(static_cast<int>(waited_s_)) + " s");
     else if (exceptions > 0)
       status.summary(DiagnosticStatus::WARN, "exceptions caught");
     else if (camera_switches_ > 0)
@@ -510,6 +524,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                      : !publish_tf_        ? std::string("off")
                      : tf_edge_.empty()    ? std::string("nothing published yet")
                                            : tf_edge_);
+    status.add("metric source", metric_source_.empty() ? "none yet (" + node_.pipeline.pose.metric_source + ")"
+                                                       : metric_source_);
     status.add("resets (total)", resets_);
     status.add("reconfigurations (total)", reconfigures_);
     status.add("planes in this image", observed_);
@@ -556,6 +572,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   cv::Size last_tracks_size_;
   size_t observed_ = 0;
   PlaneArrayConstPtr last_planes_;
+  std::string metric_source_;     // the source that started the map, "" before
+  bool odometry_stopped_ = false;  // metric_source odometry but none for the last image
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string tf_edge_;           // what is published

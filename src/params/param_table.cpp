@@ -278,6 +278,17 @@ const ParamTable<PoseParams>& poseParamTable() {
          "triangulated points must be this far in front of both views"},
         {"max_landmarks", field(&P::max_landmarks), 1, 10000000, "",
          "least recently seen 3D points dropped beyond this", "max_landmarks"},
+        {"metric_source", field(&P::metric_source), 0, 0, "",
+         "where the metres come from: target, odometry (tf odom_frame -> camera; the map is "
+         "the odometry frame), camera_height (the floor lies camera_height_m below the "
+         "camera) or auto (the first of them available)"},
+        {"camera_height_m", [](P& p) -> ParamField { return &p.floor.camera_height_m; }, 0, 100,
+         "m", "camera_height: the optical centre's height above the floor (0: unknown)"},
+        {"camera_pitch_deg", [](P& p) -> ParamField { return &p.floor.pitch_down_deg; }, -90, 90,
+         "deg", "camera_height: nominal camera tilt below the horizon, to tell the floor"},
+        {"floor_max_angle_deg", [](P& p) -> ParamField { return &p.floor.max_floor_angle_deg; },
+         1, 89, "deg",
+         "camera_height: the floor's normal is within this of the nominal down direction"},
     };
     appendNested(t, "two_view/", &P::two_view, twoViewParamTable());
     return t;
@@ -560,10 +571,25 @@ std::vector<std::string> validate(TrackerNodeParams& params) {
   return errors;
 }
 
+// A metric source that cannot work says so at start rather than waiting for ever.
+static void checkMetricSource(PlaneNodeParams& p, std::vector<std::string>& errors) {
+  PoseParams& pose = p.pipeline.pose;
+  if (const std::string error = metricSourceError(pose.metric_source); !error.empty()) {
+    errors.push_back("pose/" + error + "; using target");
+    pose.metric_source = "target";
+  }
+  if (pose.metric_source == "odometry" && p.odom_frame.empty())
+    errors.push_back("pose/metric_source odometry needs odom_frame: no metres until it is set");
+  if (pose.metric_source == "camera_height" && !(pose.floor.camera_height_m > 0))
+    errors.push_back(
+        "pose/metric_source camera_height needs pose/camera_height_m > 0: no metres until set");
+}
+
 std::vector<std::string> validate(PlaneNodeParams& params) {
   auto errors = validate(params, planeNodeParamTable());
   checkRateWindow(params, errors);
   checkTargetNames(params.pipeline.target, errors);
+  checkMetricSource(params, errors);
   return errors;
 }
 

@@ -23,6 +23,7 @@
 #include <limits>
 #include <sstream>
 #include <map>
+#include <optional>
 
 #include "mono_plane_detection/PlaneArray.h"
 #include "mono_plane_detection/Tracks.h"
@@ -405,6 +406,73 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   std::string parent;
   ASSERT_TRUE(buffer._getParent("odom", ros::Time(0), parent));
   EXPECT_EQ(parent, "map_odom_test");
+}
+
+// metric_source odometry without a target (issue 12 part 3): metric from the first
+// image, PlaneArray.metric_source says so; a tf that stops leaves the pose to vision
+// (no jump) and the diagnostics WARN; the odometry takes over again when it returns.
+TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
+  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom_source", 20);
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
+      "planes_odom_source", 50,
+      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_source: planes");
+  tf2_ros::TransformBroadcaster broadcaster;
+  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  std::optional<cv::Vec3d> previous;
+  double worst_step = 0;
+  {  // a new broadcaster: let the nodelet's tf listener connect before the first image
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(world_->frame(0).stamp + 3500 - 1);
+    tf.header.frame_id = "odom_source";
+    tf.child_frame_id = "camera_optical_source";
+    tf.transform = toTransformMsg(rosMapFromTarget() * world_->truthMapFromCamera(0));
+    for (int i = 0; i < 10; ++i) {
+      broadcaster.sendTransform(tf);
+      ros::WallDuration(0.1 * timeoutScale()).sleep();
+    }
+  }
+  for (int k = 0; k < 120; ++k) {
+    const double t = k / 30.0;
+    TrackFrame f = world_->frame(t);
+    for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;  // no target
+    f.stamp += 3500;  // its own time line
+    const bool tf_stopped = k >= 70 && k < 100;
+    if (!tf_stopped) {
+      geometry_msgs::TransformStamped tf;
+      tf.header.stamp = ros::Time(f.stamp);
+      tf.header.frame_id = "odom_source";
+      tf.child_frame_id = "camera_optical_source";  // a camera of its own: one parent each
+      tf.transform = toTransformMsg(rosMapFromTarget() * world_->truthMapFromCamera(t));
+      broadcaster.sendTransform(tf);
+      ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    }
+    TracksPtr msg = toTracks(f);
+    msg->header.frame_id = "camera_optical_source";
+    tracks.publish(msg);
+    const PlaneArrayConstPtr last = waitFor(answers, ros::Time(f.stamp).toNSec());
+    ASSERT_TRUE(last) << "image " << k;
+    ASSERT_TRUE(last->metric) << "image " << k << ": " << last->status;
+    EXPECT_EQ(last->metric_source, "odometry");
+    // The map is the odometry frame: the camera where the odometry says.
+    const cv::Vec3d at = targetFromRosMap(fromPoseMsg(last->camera_pose)).t;
+    EXPECT_LT(cv::norm(at - world_->truthMapFromCamera(t).t), 0.05) << "image " << k;
+    if (previous) worst_step = std::max(worst_step, cv::norm(at - *previous));
+    previous = at;
+    if (k == 69) EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k == 99) {
+      EXPECT_EQ(last->status, "tracking (landmarks)");
+      ASSERT_TRUE(diagnostics.waitFresh());
+      EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+      EXPECT_NE(diagnostics.message().find("odometry (odom_source) stopped"), std::string::npos)
+          << diagnostics.message();
+      EXPECT_EQ(diagnostics.value("metric source"), "odometry");
+    }
+    if (k == 119) EXPECT_EQ(last->status, "tracking (odometry)");
+  }
+  EXPECT_LT(worst_step, 0.05);  // 0.01 m per image
 }
 
 // Killing the plane nodelet while tracks keep coming, and loading it again: it answers

@@ -3,10 +3,13 @@
 // triangulated into landmarks once they have seen enough parallax, and the landmarks
 // place the camera (PnP) after the target has left the view. Optionally an odometry
 // pose (odom -> camera) replaces the visual estimate, the target fixing map -> odom.
-// ROS-free.
+// Without a target the metres come from the odometry itself (the map is the odometry
+// frame) or from the camera's known height above the floor (camera_height_scale.h):
+// PoseParams::metric_source. ROS-free.
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -16,6 +19,7 @@
 #include "mono_plane_detection/geometry/pose.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 #include "mono_plane_detection/tracking/track_frame.h"
+#include "mono_plane_detection/mapping/camera_height_scale.h"
 #include "mono_plane_detection/mapping/two_view_init.h"
 
 namespace mono_plane_detection {
@@ -30,7 +34,17 @@ struct PoseParams {
   double min_depth_m = 0.05;          // triangulated points must be this far in front of both views
   size_t max_landmarks = 5000;        // least recently seen are dropped beyond this
   TwoViewParams two_view;             // the metric start (two_view_init.h)
+  // Where the metres come from: target | odometry | camera_height | auto (the first of
+  // them that is available). Once one has started the map, the others are ignored.
+  std::string metric_source = "target";
+  FloorParams floor;  // camera_height (camera_height_scale.h)
 };
+
+// The source that started the metric map.
+enum class MetricSource { kNone, kTarget, kOdometry, kCameraHeight };
+const char* toString(MetricSource source);
+// Empty when `choice` is one of target, odometry, camera_height, auto; else why not.
+std::string metricSourceError(const std::string& choice);
 
 // A track's 3D point. Before triangulation only its first observation with a known
 // camera pose (the anchor) is known.
@@ -42,6 +56,10 @@ struct Landmark {
   cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
   double parallax_deg = 0;        // between the two rays of the triangulation
   double last_seen = 0;           // stamp, s
+  // Anchored or triangulated from a vision-only pose while the odometry of an odometry
+  // map was missing: used to place the camera, not given out (landmarkPosition), and
+  // started again from the odometry when it returns.
+  bool provisional = false;
 };
 
 enum class PoseSource { kTarget, kLandmarks, kOdometry };
@@ -63,17 +81,23 @@ class PoseEstimator {
   // The camera's pose for this frame, nothing while it cannot be known (target not seen
   // yet, start not done: not enough motion yet, too few landmarks). Triangulates new
   // landmarks when the pose is known.
-  // odom_from_camera: the robot's odometry for this frame, when it has one.
+  // odom_from_camera: the robot's odometry for this frame, when it has one, in the
+  // core's axis convention (y up: the ROS boundary turns a z-up odometry frame into it,
+  // ros/map_frame.h). With metric_source odometry the map IS this odometry frame.
   std::optional<PoseEstimate> update(const TrackFrame& frame,
                                      const std::optional<Pose>& odom_from_camera = {});
 
-  // True once the target has been seen: poses are in metres.
-  bool scaleKnown() const { return !target_ids_.empty(); }
+  // True once a metric source has started: poses are in metres (for the target: once
+  // it has been seen, before the two-view start).
+  bool scaleKnown() const { return metric_ != MetricSource::kNone; }
+  MetricSource metricSource() const { return metric_; }
+  // What the start waits for, for people ("waiting for target", ...).
+  std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
   // comes from the target alone and nothing is triangulated).
   bool initialised() const { return initialised_; }
   const std::unordered_map<std::uint64_t, Landmark>& landmarks() const { return landmarks_; }
-  // Triangulated (or fixed) landmark position of a track, if any.
+  // Triangulated (or fixed) landmark position of a track, if any (not provisional).
   std::optional<cv::Vec3d> landmarkPosition(std::uint64_t id) const;
   // After a pause (tracking loss) the last pose is no guide to the next.
   void forgetLastPose() { last_pose_.reset(); }
@@ -87,6 +111,16 @@ class PoseEstimator {
   std::optional<PoseEstimate> initialise(const TrackFrame& frame,
                                          const std::vector<cv::Point2d>& normalized);
   std::optional<PoseEstimate> targetPose(const TrackFrame& frame) const;
+  std::optional<PoseEstimate> startFromFloor(const TrackFrame& frame,
+                                             const std::vector<cv::Point2d>& normalized);
+  // Landmarks of a two-view start; the second view is this frame.
+  void placeStartLandmarks(const TrackFrame& frame, const std::vector<std::uint64_t>& ids,
+                           const std::vector<cv::Point2d>& second, const std::vector<int>& points,
+                           const std::vector<cv::Vec3d>& points_map, double parallax_deg,
+                           const Pose& map_from_second);
+  bool allows(MetricSource source) const;
+  void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                          const Pose& map_from_camera);
   void forgetOldLandmarks();
 
   struct FirstView {  // the image the two-view start measures motion from
@@ -107,8 +141,15 @@ class PoseEstimator {
   std::unordered_map<std::uint64_t, Landmark> landmarks_;
   std::optional<Pose> last_pose_;
   std::optional<Pose> map_from_odom_;
+  bool vision_only_ = false;  // odometry map, odometry missing for this image
   bool initialised_ = false;
   std::optional<FirstView> first_view_;
+  MetricSource metric_ = MetricSource::kNone;
+  std::string floor_reason_;  // why the camera_height start has not happened yet
+  // camera_height: earlier images the floor's motion is measured from (every 5th, the
+  // last 2 s), the oldest that still shares most tracks tried first (most parallax).
+  std::deque<FirstView> floor_views_;
+  int frames_seen_ = 0;
 };
 
 }  // namespace mono_plane_detection
