@@ -14,6 +14,7 @@
 
 #include "cli_args.h"
 #include "mono_plane_detection/eval/segmentation_error.h"
+#include "mono_plane_detection/eval/sequential_magsac.h"
 #include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
@@ -50,35 +51,6 @@ std::vector<int> readLabels(const std::string& path, std::string& error) {
       return {};
     }
     labels.push_back(label);
-  }
-  return labels;
-}
-
-// The plane detector a user might pick instead: MAGSAC++ homography (cv::findHomography
-// USAC_MAGSAC), remove its inliers, repeat while a plane with min_support points is found.
-std::vector<int> sequentialMagsac(const std::vector<cv::Point2d>& a,
-                                  const std::vector<cv::Point2d>& b, double threshold,
-                                  int min_support, int max_planes) {
-  std::vector<int> labels(a.size(), 0), remaining(a.size());
-  for (size_t i = 0; i < a.size(); ++i) remaining[i] = static_cast<int>(i);
-  for (int plane = 1; plane <= max_planes && static_cast<int>(remaining.size()) >= min_support;
-       ++plane) {
-    std::vector<cv::Point2d> ra, rb;
-    for (int i : remaining) {
-      ra.push_back(a[i]);
-      rb.push_back(b[i]);
-    }
-    cv::Mat mask;
-    const cv::Mat H = cv::findHomography(ra, rb, cv::USAC_MAGSAC, threshold, mask, 1000, 0.99);
-    if (H.empty() || cv::countNonZero(mask) < min_support) break;
-    std::vector<int> rest;
-    for (size_t k = 0; k < remaining.size(); ++k) {
-      if (mask.at<uchar>(static_cast<int>(k)))
-        labels[remaining[k]] = plane;
-      else
-        rest.push_back(remaining[k]);
-    }
-    remaining.swap(rest);
   }
   return labels;
 }
