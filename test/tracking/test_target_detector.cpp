@@ -453,3 +453,27 @@ TEST(TargetDetector, RejectionsSayWhy) {
   d = detectTarget(cv::Mat());
   EXPECT_EQ(d.rejection, TargetRejection::kBadImage);
 }
+
+// make fuzz found a 40x30 image where the fitted sides met 0.3 px past the border: a
+// found target must have every corner inside the image (tracks outside are refused).
+TEST(TargetDetector, FoundCornersAreInsideTheImage) {
+  std::ifstream in(std::string(TEST_DATA_DIR) + "/../fuzz/corpus/target_detector/crash_corner_outside_image",
+                   std::ios::binary);
+  const std::vector<unsigned char> data((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(data.size(), 2u);
+  const int cols = 1 + data[0] % 96, rows = 1 + data[1] % 96;  // as fuzz_target_detector
+  cv::Mat image(rows, cols, CV_8UC1, cv::Scalar(0));
+  for (size_t i = 2; i < data.size() && i - 2 < image.total(); ++i) image.data[i - 2] = data[i];
+  TargetParams params;
+  params.min_area_px = 20;
+  const TargetDetection d = detectTarget(image, params);
+  if (d.found)
+    for (const auto& c : d.corners) {
+      EXPECT_GE(c.x, 0);
+      EXPECT_GE(c.y, 0);
+      EXPECT_LE(c.x, cols - 1);
+      EXPECT_LE(c.y, rows - 1);
+    }
+  else
+    EXPECT_EQ(d.rejection, TargetRejection::kAtImageEdge) << d.reason;
+}
