@@ -36,12 +36,9 @@ std::string jsonString(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The tracker's target settings of a profile first, so that options override them.
-  std::string profile = profileArgument(argc, argv, "default");
-  TrackerNodeParams node;
-  const std::vector<std::string> profile_errors =
-      loadProfile(MPD_CONFIG_DIR, "tracker", profile, trackerNodeParamTable(), node);
-  TargetParams params = node.target;
+  auto profile =
+      readToolProfile(argc, argv, MPD_CONFIG_DIR, "tracker", trackerNodeParamTable(), std::string("default"));
+  TargetParams params = profile.params.target;
   std::vector<std::string> images;
   bool json = false;
   double focal_px = 0;
@@ -54,10 +51,7 @@ int main(int argc, char** argv) {
       "  'IMAGE: none (reason)'; --json: one array of objects.\n"
       "exit codes: 0 ran (found or not), 2 bad usage or an unreadable image\n");
   cli.positionals("IMAGE", &images, "image files (any format OpenCV reads)")
-      .text("profile", &profile,
-            "target settings of config/tracker.yaml with the overlay of profile P (default, "
-            "wheeled, humanoid) or a .yaml file over it; none: the core's defaults",
-            "P")
+      .text("profile", &profile.name, profileHelp("tracker"), "P")
       .choice("target-type", &params.target_type, {"sheet", "aruco"}, "which target")
       .number("width-m", &params.width_m, 0.01, 10, "sheet: longer side, metres", "M")
       .number("height-m", &params.height_m, 0.01, 10, "sheet: shorter side, metres", "M")
@@ -69,7 +63,7 @@ int main(int argc, char** argv) {
               "aruco: side of the black square, metres", "M")
       .flag("json", &json, "print JSON");
   if (const auto code = cli.parse(argc, argv)) return *code;
-  if (!profile_errors.empty()) return cli.fail(profile_errors.front());
+  if (!profile.errors.empty()) return cli.fail(profile.errors.front());
   if (const std::string error = targetParamsError(params); !error.empty()) return cli.fail(error);
 
   int exit_code = 0;

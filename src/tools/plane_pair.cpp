@@ -43,12 +43,9 @@ cv::Ptr<cv::Feature2D> detector(const std::string& name, int features) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The plane settings of a profile first (default none: the core's), options override.
-  std::string profile = profileArgument(argc, argv, "none");
-  PlaneNodeParams node;
-  const std::vector<std::string> profile_errors =
-      loadProfile(MPD_CONFIG_DIR, "planes", profile, planeNodeParamTable(), node);
-  PlaneParams params = node.pipeline.planes;
+  auto profile =
+      readToolProfile(argc, argv, MPD_CONFIG_DIR, "planes", planeNodeParamTable(), std::string("none"));
+  PlaneParams params = profile.params.pipeline.planes;
   Intrinsics in1, in2;
   std::string img1, img2, overlay = "plane_pair.png", features = "sift";
   int max_features = 4000;
@@ -62,10 +59,7 @@ int main(int argc, char** argv) {
                   "  to undistorted pixels of image 2.",
                   "exit codes: 0 done, 2 bad usage or unreadable image\n");
   cli.positional("IMG1", &img1, "first image").positional("IMG2", &img2, "second image");
-  cli.text("profile", &profile,
-           "plane parameters of config/planes.yaml with the overlay of profile P (default, "
-           "wheeled, humanoid) or a .yaml file over it; none: the core's defaults",
-           "P");
+  cli.text("profile", &profile.name, profileHelp("planes"), "P");
   cli.number("fx", &in1.fx, 1e-6, 1e6, "focal length x, pixels", "PX")
       .number("fy", &in1.fy, 1e-6, 1e6, "focal length y, pixels", "PX")
       .number("cx", &in1.cx, -1e6, 1e6, "principal point x, pixels", "PX")
@@ -95,7 +89,7 @@ int main(int argc, char** argv) {
       .text("overlay", &overlay, "where to write the overlay image", "FILE.png")
       .flag("json", &json, "print the planes as JSON (homography, inlier correspondences)");
   if (const auto code = cli.parse(argc, argv)) return *code;
-  if (!profile_errors.empty()) return cli.fail(profile_errors.front());
+  if (!profile.errors.empty()) return cli.fail(profile.errors.front());
   if (in1.fx <= 0 || in1.fy <= 0) return cli.fail("--fx and --fy are needed (pixels)");
   if (in2.fx <= 0) in2 = in1;
   if (in2.fy <= 0) in2.fy = in2.fx;

@@ -86,4 +86,30 @@ inline std::string profileArgument(int argc, const char* const* argv, const std:
   return fallback;
 }
 
+// A tool's --profile, read before the parser runs so that the profile's values show in
+// --help and options given on the command line override them.
+template <class P>
+struct ToolProfile {
+  std::string name;                 // register &name as the "profile" option
+  P params;                         // the nodelet's parameters under that profile
+  std::vector<std::string> errors;  // report the first after parsing (cli.fail)
+};
+
+template <class P>
+ToolProfile<P> readToolProfile(int argc, const char* const* argv, const std::string& config_dir,
+                               const std::string& nodelet, const ParamTable<P>& table,
+                               const std::string& fallback) {
+  ToolProfile<P> profile;
+  profile.name = profileArgument(argc, argv, fallback);
+  profile.errors = loadProfile(config_dir, nodelet, profile.name, table, profile.params);
+  return profile;
+}
+
+// The option's help, the same in every tool.
+inline std::string profileHelp(const std::string& nodelet) {
+  return "parameters of config/" + nodelet +
+         ".yaml with the overlay of profile P (default, wheeled, humanoid) or a .yaml file "
+         "over it; none: the core's defaults";
+}
+
 }  // namespace mono_plane_detection

@@ -42,12 +42,9 @@ void printJson(const PlaneSegmentation& result, size_t points) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // The profile first, so that its values show in --help and options override them.
-  std::string profile = profileArgument(argc, argv, "none");
-  PlaneNodeParams node;
-  const std::vector<std::string> profile_errors =
-      loadProfile(MPD_CONFIG_DIR, "planes", profile, planeNodeParamTable(), node);
-  PlaneParams params = node.pipeline.planes;
+  auto profile =
+      readToolProfile(argc, argv, MPD_CONFIG_DIR, "planes", planeNodeParamTable(), std::string("none"));
+  PlaneParams params = profile.params.pipeline.planes;
   bool json = false;
   std::string path;
   cli::Parser cli("segment_planes", "[options] FILE|-",
@@ -59,10 +56,7 @@ int main(int argc, char** argv) {
                   "  (planes numbered by support, largest first).\n"
                   "exit codes: 0 done (fewer than 5 points: all labels 0), 2 bad usage or input\n");
   cli.positional("FILE", &path, "the correspondences; '-' reads standard input")
-      .text("profile", &profile,
-            "plane parameters of config/planes.yaml with the overlay of profile P (default, "
-            "wheeled, humanoid) or a .yaml file over it; none: the core's defaults",
-            "P")
+      .text("profile", &profile.name, profileHelp("planes"), "P")
       .number("threshold", &params.vote_threshold_px, 0.0, 1e3,
               "transfer error for a point to vote / belong, pixels; 0 = estimate the noise "
               "scale from the data (default)", "PX")
@@ -87,7 +81,7 @@ int main(int argc, char** argv) {
                          "seed of the group choice", "S")
       .flag("json", &json, "print planes (homography, inliers, rms error) instead of labels");
   if (const auto code = cli.parse(argc, argv)) return *code;
-  if (!profile_errors.empty()) return cli.fail(profile_errors.front());
+  if (!profile.errors.empty()) return cli.fail(profile.errors.front());
 
   Correspondences input;
   if (path == "-") {

@@ -120,3 +120,18 @@ TEST(Profile, SetFromTextReadsByTheFieldsType) {
   EXPECT_EQ(setFromText(&s, "camera_optical", 0, 0), "");
   EXPECT_EQ(s, "camera_optical");
 }
+
+TEST(Profile, ToolProfileReadsTheArgumentAndItsFiles) {
+  const char* args[] = {"tool", "--profile", "humanoid", "x.png"};
+  const auto profile = readToolProfile(4, args, std::string(SOURCE_DIR) + "/config", "tracker",
+                                       trackerNodeParamTable(), std::string("none"));
+  EXPECT_EQ(profile.name, "humanoid");
+  EXPECT_TRUE(profile.errors.empty());
+  EXPECT_EQ(profile.params.tracker.window_size_px, 15);
+  const char* none[] = {"tool"};
+  const auto fallback = readToolProfile(1, none, std::string(SOURCE_DIR) + "/config", "tracker",
+                                        trackerNodeParamTable(), std::string("none"));
+  EXPECT_EQ(fallback.name, "none");
+  EXPECT_EQ(fallback.params.tracker.window_size_px, TrackerNodeParams().tracker.window_size_px);
+  EXPECT_NE(profileHelp("planes").find("config/planes.yaml"), std::string::npos);
+}
