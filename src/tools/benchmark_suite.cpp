@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "thread_cpu_time.h"
 #include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/eval/sequential_magsac.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
@@ -29,14 +30,6 @@ using namespace mono_plane_detection;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-// CPU time of this thread, ms: the plane rows compare two methods on one thread, and on a
-// shared machine wall time mostly measures the wait for a core (it varied 2x between runs).
-double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -134,19 +127,19 @@ PlaneRow benchPlanes(int points, int repeats) {
     const auto scene = makeTwoViewScene(sp);
     PlaneParams params;
     params.vote_threshold_px = 4.0 * sp.noise_px;
-    double start = cpuMs();
+    double start = threadCpuMs();
     const auto result = segmentPlanes(scene.view1, scene.view2, params);
-    ours.push_back(cpuMs() - start);
+    ours.push_back(threadCpuMs() - start);
     // The plane nodelet's setting (config/planes.yaml): 100 coplanar groups per image.
     PlaneParams fewer = params;
     fewer.groups.max_groups = 100;
-    start = cpuMs();
+    start = threadCpuMs();
     const auto fewer_result = segmentPlanes(scene.view1, scene.view2, fewer);
-    nodelet.push_back(cpuMs() - start);
-    start = cpuMs();
+    nodelet.push_back(threadCpuMs() - start);
+    start = threadCpuMs();
     const auto labels = sequentialMagsac(scene.view1, scene.view2, params.vote_threshold_px,
                                          params.min_plane_support, params.max_planes);
-    base.push_back(cpuMs() - start);
+    base.push_back(threadCpuMs() - start);
     row.our_error += 100 * misclassificationError(scene.labels, result.labels) / repeats;
     row.nodelet_error += 100 * misclassificationError(scene.labels, fewer_result.labels) / repeats;
     row.baseline_error += 100 * misclassificationError(scene.labels, labels) / repeats;

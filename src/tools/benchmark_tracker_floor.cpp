@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "thread_cpu_time.h"
 #include "mono_plane_detection/eval/track_scorer.h"
 #include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
@@ -35,14 +36,6 @@ using namespace mono_plane_detection;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-// CPU time of this thread: the machine is shared, and time spent waiting for a core is
-// not the tracker's cost (wall time is printed too, for the record).
-double threadMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
 
 const int kSteadyFrom = 20;  // images before this one are the start-up, not the steady state
 
@@ -97,11 +90,11 @@ struct Record {
     g_allocations = 0;
     g_bytes = 0;
     g_counting = steady;
-    const double cpu = threadMs();
+    const double cpu = threadCpuMs();
     const auto wall = Clock::now();
     const bool searched = work();
     wall_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - wall).count());
-    ms.push_back(threadMs() - cpu);
+    ms.push_back(threadCpuMs() - cpu);
     g_counting = false;
     if (!steady) return;
     allocations[searched] += g_allocations;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "thread_cpu_time.h"
 #include "mono_plane_detection/eval/segmentation_error.h"
 #include "mono_plane_detection/eval/sequential_magsac.h"
 #include "mono_plane_detection/planes/correspondence_io.h"
@@ -23,14 +24,6 @@ using namespace mono_plane_detection;
 namespace fs = std::filesystem;
 
 namespace {
-
-// CPU time of this thread, ms: on a shared machine wall time mostly measures the wait
-// for a core (both methods run on this one thread, cv::setNumThreads(1)).
-double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
-}
 
 // One integer per line, '#' comments; empty on a malformed line.
 std::vector<int> readLabels(const std::string& path, std::string& error) {
@@ -140,9 +133,9 @@ int main(int argc, char** argv) {
       PlaneParams p = params;
       p.groups.seed = static_cast<unsigned>(seed);
       PlaneSegmentation result;
-      const double start = cpuMs();
+      const double start = threadCpuMs();
       for (int r = 0; r < repeats; ++r) result = segmentPlanes(v1, v2, p);
-      ms += (cpuMs() - start) / repeats / seeds;
+      ms += (threadCpuMs() - start) / repeats / seeds;
       const double e = 100.0 * misclassificationError(s.truth, result.labels);
       err += e / seeds;
       worst = std::max(worst, e);
@@ -165,11 +158,11 @@ int main(int argc, char** argv) {
       for (const HomographyPlane& plane : result.planes) per += cv::format(" %.3f", plane.noise_px);
     }
     std::vector<int> magsac;
-    const double start = cpuMs();
+    const double start = threadCpuMs();
     for (int r = 0; r < repeats; ++r)
       magsac = sequentialMagsac(v1, v2, magsac_threshold, params.min_plane_support,
                                 params.max_planes);
-    const double magsac_ms = (cpuMs() - start) / repeats;
+    const double magsac_ms = (threadCpuMs() - start) / repeats;
     const double magsac_err = 100.0 * misclassificationError(s.truth, magsac);
     const int planes = *std::max_element(s.truth.begin(), s.truth.end());
     std::printf("%-14s %6zu %6d %6.1f %8.3f %8.2f %8.2f %9.2f %9.2f %9.2f\n", s.name.c_str(),
