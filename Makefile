@@ -108,7 +108,7 @@ sanitize: deps
 	@$(MAKE) --no-print-directory link
 	@cd $(ASAN_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" tests > $(ASAN_WS)/build.log 2>&1 \
+	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
 	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
 	@rostest_hosted=" $$(grep -o 'add_rostest_gtest(test_[a-z0-9_]*' CMakeLists.txt | sed 's/.*(//' | tr '\n' ' ') "; \
 	passed=0; failed=0; for t in $(ASAN_WS)/devel/lib/mono_plane_detection/test_*; do \
