@@ -233,9 +233,7 @@ const ParamTable<PlaneParams>& planeParamTable() {
         {"noise_pilot_groups", field(&P::noise_pilot_groups), 1, 10000, "",
          "candidate first planes the noise scale is estimated from"},
         {"epipolar_check", field(&P::epipolar_check), 0, 1, "",
-         "reject homographies not induced by a plane of the estimated fundamental matrix"},
-        {"epipolar_threshold_sigma", field(&P::epipolar_threshold_sigma), 0.1, 1000, "sigma",
-         "epipolar check: median epipolar transfer error allowed, noise scales"},
+         "drop planes whose points are mostly off the epipolar lines of F from the planes' points"},
     };
     appendNested(t, "groups/", &P::groups, groupParamTable());
     appendNested(t, "noise/", &P::noise, noiseScaleParamTable());

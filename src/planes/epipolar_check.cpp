@@ -39,6 +39,13 @@ double epipolarTransferError(const cv::Matx33d& H, const cv::Matx33d& F,
   return d[d.size() / 2];
 }
 
+double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const cv::Point2d& x2) {
+  const cv::Vec3d line = F * cv::Vec3d(x1.x, x1.y, 1.0);
+  const double n = std::sqrt(line[0] * line[0] + line[1] * line[1]);
+  if (!(n > 1e-15)) return std::numeric_limits<double>::infinity();
+  return std::abs(line[0] * x2.x + line[1] * x2.y + line[2]) / n;
+}
+
 double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F) {
   const double nh = cv::norm(H), nf = cv::norm(F);
   if (nh <= 0 || nf <= 0) return 1.0;
@@ -46,6 +53,74 @@ double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F) {
   const double ns = cv::norm(S);
   if (ns <= 0) return 0.0;
   return cv::norm(S + S.t()) / (2.0 * ns);
+}
+
+}  // namespace mono_plane_detection
+
+namespace mono_plane_detection {
+namespace {
+
+// Moves points to zero mean and mean distance sqrt(2) (Hartley's normalisation).
+cv::Matx33d normalising(const std::vector<cv::Point2d>& p) {
+  cv::Point2d c(0, 0);
+  for (const cv::Point2d& q : p) c += q;
+  c *= 1.0 / std::max<size_t>(1, p.size());
+  double d = 0.0;
+  for (const cv::Point2d& q : p) d += cv::norm(q - c);
+  d /= std::max<size_t>(1, p.size());
+  const double s = d > 0.0 ? std::sqrt(2.0) / d : 1.0;
+  return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
+}
+
+cv::Vec3d homogeneous(const cv::Point2d& p) { return {p.x, p.y, 1.0}; }
+
+}  // namespace
+
+std::optional<cv::Matx33d> fitInducedHomography(const cv::Matx33d& H1, const cv::Vec3d& e2,
+                                                const std::vector<cv::Point2d>& from,
+                                                const std::vector<cv::Point2d>& to,
+                                                const std::vector<double>& weights) {
+  if (from.size() != to.size() || from.size() < 3 ||
+      (!weights.empty() && weights.size() != from.size()))
+    return std::nullopt;
+  const cv::Matx33d T1 = normalising(from), T2 = normalising(to);
+  const cv::Matx33d H = T2 * H1 * T1.inv();
+  const cv::Vec3d e = T2 * e2;
+  std::vector<cv::Vec3d> x(from.size()), y(from.size());
+  for (size_t i = 0; i < from.size(); ++i) {
+    x[i] = T1 * homogeneous(from[i]);
+    y[i] = T2 * homogeneous(to[i]);
+  }
+  // y x ((H + e v^T) x) = 0: two rows per point, linear in v. Each row divided by the
+  // image's third coordinate (from the last round) is the transfer error.
+  cv::Vec3d v(0, 0, 0);
+  bool solved = false;
+  for (int round = 0; round < 4; ++round) {
+    cv::Matx33d N = cv::Matx33d::zeros();
+    cv::Vec3d r(0, 0, 0);
+    for (size_t i = 0; i < x.size(); ++i) {
+      const cv::Vec3d h = H * x[i];
+      const double s = v.dot(x[i]);
+      const double z = h[2] + e[2] * s;
+      const double w = (weights.empty() ? 1.0 : weights[i]) / std::max(z * z, 1e-12);
+      if (!(w > 0.0) || !std::isfinite(w)) continue;
+      const double c0 = y[i][1] * e[2] - e[1], r0 = y[i][1] * h[2] - h[1];
+      const double c1 = e[0] - y[i][0] * e[2], r1 = h[0] - y[i][0] * h[2];
+      N += (x[i] * x[i].t()) * (w * (c0 * c0 + c1 * c1));
+      r -= x[i] * (w * (c0 * r0 + c1 * r1));
+    }
+    cv::Matx31d values;
+    cv::Matx33d vectors;
+    cv::eigen(N, values, vectors);
+    if (!(values(2) > 1e-9 * values(0))) return std::nullopt;  // v not fixed (collinear points)
+    v = N.solve(r, cv::DECOMP_CHOLESKY);
+    solved = true;
+  }
+  if (!solved) return std::nullopt;
+  cv::Matx33d out = T2.inv() * (H + e * v.t()) * T1;
+  const double norm = cv::norm(out);
+  if (!(norm > 0.0) || !std::isfinite(norm)) return std::nullopt;
+  return out * (1.0 / norm);
 }
 
 }  // namespace mono_plane_detection

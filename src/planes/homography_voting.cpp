@@ -159,8 +159,7 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
 // two when their cost plus one more label cost is below its cost.
 void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Matx33d>& candidates,
                  const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
-                 const PlaneParams& params, const Energy& energy, double vote_px,
-                 const std::optional<cv::Matx33d>& F) {
+                 const PlaneParams& params, const Energy& energy, double vote_px) {
   const size_t count = planes.size();
   for (size_t p = 0; p < count; ++p) {
     const std::vector<int> members = planes[p].inliers;
@@ -200,9 +199,6 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
       setPlaneNoise(out, view1, view2, active, energy, params);
-      if (F && epipolarTransferError(out.H, *F, view1) >
-                   params.epipolar_threshold_sigma * energy.sigma)
-        return false;  // only plane-induced pieces
       return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
     };
     const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
@@ -305,6 +301,58 @@ void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
     if (stable) break;
   }
   for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+}
+
+// Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
+// homography a plane induces lie on their epipolar lines. F by RANSAC on the points of
+// the planes found (the outliers left out: few samples are needed and a degenerate sample,
+// mostly from one plane, loses to the true F), at the vote's threshold; when it is
+// determined (its inliers hold at least a plane's worth of points off the plane holding
+// most of them: points of one plane and a few others leave a family of F), a plane most of
+// whose points are off their epipolar lines is dropped (on EuRoC: repeated texture matched
+// one period off, consistent with a homography but not with the epipolar geometry); its
+// points go to the other planes or become outliers.
+void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
+                    const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                    const Energy& energy, double vote_px, PlaneSegmentation& out) {
+  if (planes.size() < 2) return;
+  // F by RANSAC on the points of the planes only (the outliers left out: few outliers
+  // remain, so few samples are needed and a degenerate sample loses to the true F).
+  std::vector<int> on_planes;
+  for (const HomographyPlane& plane : planes)
+    on_planes.insert(on_planes.end(), plane.inliers.begin(), plane.inliers.end());
+  const std::vector<cv::Point2d> a = select(view1, on_planes), b = select(view2, on_planes);
+  const auto F = estimateFundamental(a, b, vote_px, 0.5, params.groups.seed);
+  if (!F) return;
+  // Determined: its inliers must include at least a plane's worth off the plane holding
+  // most of them (points of one plane and a few others leave a family of F).
+  std::vector<int> agree(planes.size(), 0);
+  std::vector<double> dist(view1.size(), std::numeric_limits<double>::infinity());
+  int total = 0;
+  for (size_t p = 0; p < planes.size(); ++p) {
+    for (int i : planes[p].inliers) {
+      dist[i] = epipolarLineDistance(*F, view1[i], view2[i]);
+      const bool in = dist[i] < vote_px;
+      agree[p] += in;
+      total += in;
+    }
+  }
+  const int most = *std::max_element(agree.begin(), agree.end());
+  if (total - most < params.min_plane_support) return;
+  out.epipolar_checked = true;
+  bool dropped = false;
+  for (size_t p = planes.size(); p-- > 0;) {
+    std::vector<double> d;
+    for (int i : planes[p].inliers) d.push_back(dist[i]);
+    if (d.empty()) continue;
+    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+    if (d[d.size() / 2] > vote_px) {
+      planes.erase(planes.begin() + static_cast<long>(p));
+      ++out.rejected_by_epipolar;
+      dropped = true;
+    }
+  }
+  if (dropped) refineAssignment(planes, view1, view2, params, energy);
 }
 
 }  // namespace
@@ -629,12 +677,6 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   std::vector<bool> active(view1.size());
   for (size_t i = 0; i < view1.size(); ++i) active[i] = finite(view1[i]) && finite(view2[i]);
 
-  std::optional<cv::Matx33d> F;
-  if (params.epipolar_check) {
-    F = estimateFundamental(view1, view2, th.inlier_px, 0.3, params.groups.seed);
-    out.epipolar_checked = F.has_value();
-  }
-
   // Paper IV-C repeated: the winner becomes a plane, its points leave the vote, while a
   // plane pays its label cost.
   std::vector<HomographyPlane> planes;
@@ -648,11 +690,6 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     bounds[vote.winner] = 0;  // used: never votes again
     if (!refitPlane(plane.H, plane.inliers, view1, view2, active, params) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
-      continue;
-    }
-    if (F && epipolarTransferError(plane.H, *F, view1) >
-                 params.epipolar_threshold_sigma * th.sigma_px) {
-      ++out.rejected_by_epipolar;
       continue;
     }
     // Its own noise scale (estimated ones only; a fixed threshold is every plane's), and
@@ -673,13 +710,18 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     planes.push_back(std::move(plane));
   }
   refineAssignment(planes, view1, view2, params, energy);
-  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px, F);
+  splitPlanes(planes, candidates, view1, view2, params, energy, vote_px);
   refineAssignment(planes, view1, view2, params, energy);
   mergeSamePlanes(planes, view1, view2, params, energy);
   refineAssignment(planes, view1, view2, params, energy);
-  std::stable_sort(planes.begin(), planes.end(), [](const HomographyPlane& a, const HomographyPlane& b) {
+  auto by_support = [](const HomographyPlane& a, const HomographyPlane& b) {
     return a.inliers.size() > b.inliers.size();
-  });
+  };
+  std::stable_sort(planes.begin(), planes.end(), by_support);
+  if (params.epipolar_check) {
+    dropNonInduced(planes, view1, view2, params, energy, vote_px, out);
+    std::stable_sort(planes.begin(), planes.end(), by_support);
+  }
   for (size_t p = 0; p < planes.size(); ++p) {
     HomographyPlane& plane = planes[p];
     for (int i : plane.inliers) out.labels[i] = static_cast<int>(p) + 1;

@@ -84,8 +84,8 @@ int main(int argc, char** argv) {
                "core: candidate first planes the noise scale is taken from")
       .integer("min-tries", &params.groups.min_tries, 1, 100000,
                "core: groups tried at least (when points x tries-per-point is fewer)")
-      .flag("epipolar-check", &params.epipolar_check,
-            "core: reject homographies not induced by a plane of the estimated F")
+      .flag("no-epipolar-check", &params.epipolar_check,
+            "core: keep planes whose points are off the epipolar lines of the planes' F", false)
       .number("magsac-threshold", &magsac_threshold, 0.01, 1e3,
               "sequential MAGSAC++: its threshold (maximum sigma), pixels", "PX")
       .flag("per-seed", &per_seed, "print every seed's error, groups, true -> found plane counts");

@@ -82,8 +82,8 @@ int main(int argc, char** argv) {
               "inlier threshold, pixels; 0 = estimated (default)", "PX")
       .choice("coplanarity-test", &params.groups.coplanarity_test, {"transfer", "cross_ratio"},
               "five-point coplanarity test")
-      .flag("epipolar-check", &params.epipolar_check,
-            "reject homographies not induced by a plane of the estimated F")
+      .flag("no-epipolar-check", &params.epipolar_check,
+            "keep planes whose points are off the epipolar lines of the planes' F", false)
       .integer<unsigned>("seed", &params.groups.seed, 0, std::numeric_limits<unsigned>::max(),
                          "seed of the group choice", "S")
       .text("overlay", &overlay, "where to write the overlay image", "FILE.png")

@@ -70,8 +70,8 @@ int main(int argc, char** argv) {
               "model selection: a plane costs this x ln(points) squared noise scales", "P")
       .choice("coplanarity-test", &params.groups.coplanarity_test, {"transfer", "cross_ratio"},
               "five-point coplanarity test")
-      .flag("epipolar-check", &params.epipolar_check,
-            "reject homographies not induced by a plane of the estimated F")
+      .flag("no-epipolar-check", &params.epipolar_check,
+            "keep planes whose points are off the epipolar lines of the planes' F", false)
       .integer("max-planes", &params.max_planes, 1, 1000, "at most K planes", "K")
       .integer("min-support", &params.min_plane_support, 4, 1000000,
                "a plane needs at least N points")

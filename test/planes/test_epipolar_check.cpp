@@ -4,6 +4,7 @@
 #include <opencv2/calib3d.hpp>
 #include <random>
 
+#include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/planes/epipolar_check.h"
 
 using namespace mono_plane_detection;
@@ -69,4 +70,61 @@ TEST(EpipolarCheck, EstimatesFFromTwoPlanes) {
   EXPECT_LT(epipolarTransferError(rig.H({0, -1, 0}, -1.2), *F, probe), 1.5);
   // Too few points: nothing.
   EXPECT_FALSE(estimateFundamental({a.begin(), a.begin() + 10}, {b.begin(), b.begin() + 10}, 1.0));
+}
+
+namespace {
+// The homography of the plane n.X = d (the convention of Rig::points):
+// R X + t = (R + t n^T / d) X on it.
+cv::Matx33d inducedBy(const Rig& rig, const cv::Vec3d& n, double d) {
+  return rig.K * (rig.R + rig.t * n.t() * (1.0 / d)) * rig.K.inv();
+}
+cv::Point2d apply(const cv::Matx33d& H, const cv::Point2d& p) {
+  const cv::Vec3d y = H * cv::Vec3d(p.x, p.y, 1);
+  return {y[0] / y[2], y[1] / y[2]};
+}
+// Two walls in front of both cameras.
+const cv::Vec3d kFront(0, 0, 1), kSide = cv::normalize(cv::Vec3d(0.5, 0, 1));
+}  // namespace
+
+TEST(EpipolarCheck, LineDistance) {
+  Rig rig;
+  const cv::Matx33d F = rig.F();
+  // x2 on the epipolar line of x1 (the image of a point at any depth): 0; moved across
+  // the line by 3 px: 3 px.
+  const cv::Point2d x1(200, 150);
+  const cv::Vec3d X = rig.K.inv() * cv::Vec3d(x1.x, x1.y, 1) * 4.0;
+  const cv::Vec3d y = rig.K * (rig.R * X + rig.t);
+  const cv::Point2d x2(y[0] / y[2], y[1] / y[2]);
+  EXPECT_LT(epipolarLineDistance(F, x1, x2), 1e-6);
+  const cv::Vec3d l = F * cv::Vec3d(x1.x, x1.y, 1);
+  const cv::Point2d n = cv::Point2d(l[0], l[1]) * (1.0 / std::hypot(l[0], l[1]));
+  EXPECT_NEAR(epipolarLineDistance(F, x1, x2 + 3.0 * n), 3.0, 1e-6);
+  EXPECT_TRUE(std::isinf(epipolarLineDistance(cv::Matx33d::zeros(), x1, x2)));
+}
+
+TEST(EpipolarCheck, InducedHomographyThroughPoints) {
+  Rig rig;
+  std::mt19937 rng(6);
+  std::vector<cv::Point2d> a, b;
+    rig.points(kSide, 2.5, 30, rng, a, b);
+  const cv::Vec3d e2 = rig.K * rig.t;
+  const auto H = fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, a, b);
+  ASSERT_TRUE(H);
+  // It is the wall's homography (within the 0.3 px noise) and plane-induced.
+  const cv::Matx33d truth = inducedBy(rig, kSide, 2.5);
+  for (const cv::Point2d& p : std::vector<cv::Point2d>{{100, 100}, {320, 240}, {600, 400}})
+    EXPECT_LT(transferError(*H, p, apply(truth, p)), 0.5);
+  EXPECT_LT(skewSymmetryError(*H, rig.F()), 1e-9);
+  // Weights are used (a zero weight ignores a gross outlier).
+  a.emplace_back(300, 200);
+  b.emplace_back(10, 10);
+  std::vector<double> w(a.size(), 1.0);
+  w.back() = 0.0;
+  const auto Hw = fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, a, b, w);
+  ASSERT_TRUE(Hw);
+  EXPECT_LT(transferError(*Hw, a[0], b[0]), 1.5);
+  // Too few points, or collinear ones: nothing.
+  EXPECT_FALSE(fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, {a[0], a[1]}, {b[0], b[1]}));
+  EXPECT_FALSE(fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, {{0, 0}, {1, 1}, {2, 2}, {3, 3}},
+                                    {{0, 0}, {1, 1}, {2, 2}, {3, 3}}));
 }

@@ -23,8 +23,22 @@ std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& v
 double epipolarTransferError(const cv::Matx33d& H, const cv::Matx33d& F,
                              const std::vector<cv::Point2d>& probe);
 
+// Distance in view 2 from x2 to the epipolar line F x1, pixels (infinity when F x1 is not
+// a line).
+double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const cv::Point2d& x2);
+
 // The algebraic form: || H^T F + F^T H || / (2 || H^T F ||) with H, F at unit norm;
 // 0 when H^T F is skew-symmetric (plane-induced), up to 1.
 double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F);
+
+// The plane-induced homography through the points, given the homography H1 of one plane
+// and the epipole e2 of view 2 (or H1 = [e2]x F): H = H1 + e2 v^T (every homography a
+// plane induces has this form; 3 unknowns instead of 8), v by least squares on the
+// transfer error (linearised, re-weighted), optionally with a weight per point. Nothing
+// when fewer than 3 points or the points do not fix v.
+std::optional<cv::Matx33d> fitInducedHomography(const cv::Matx33d& H1, const cv::Vec3d& e2,
+                                                const std::vector<cv::Point2d>& from,
+                                                const std::vector<cv::Point2d>& to,
+                                                const std::vector<double>& weights = {});
 
 }  // namespace mono_plane_detection

@@ -36,10 +36,10 @@ struct PlaneParams {
   bool robust_refit = true;             // Cauchy re-weighting in the refit
   NoiseScaleParams noise;               // the estimate's bounds
   int noise_pilot_groups = 20;          // candidate first planes the noise scale is taken from
-  // Reject homographies not induced by a plane when a fundamental matrix can be estimated
-  // (planes/epipolar_check.h). Off: it cost accuracy on AdelaideRMF (docs/plane_core.md).
-  bool epipolar_check = false;
-  double epipolar_threshold_sigma = 6.0;  // median epipolar transfer error allowed
+  // Only plane-induced homographies: F by RANSAC on the points of the planes found, and
+  // when it is determined, a plane most of whose points are off their epipolar lines
+  // (beyond the vote's threshold) is dropped (planes/epipolar_check.h, docs/plane_core.md).
+  bool epipolar_check = true;
 };
 
 // The threshold and noise scale params imply when vote_threshold_px fixes them
@@ -104,8 +104,8 @@ struct PlaneSegmentation {
   double noise_px = 0.0;                    // noise scale used (estimated or implied)
   double threshold_px = 0.0;                // inlier threshold used
   int duplicates = 0;                       // repeated correspondences (labelled as their first)
-  bool epipolar_checked = false;            // a fundamental matrix was found and used
-  int rejected_by_epipolar = 0;             // candidate planes it rejected
+  bool epipolar_checked = false;            // a determined fundamental matrix was used
+  int rejected_by_epipolar = 0;             // planes it dropped
   std::string error;                        // why nothing could be done (sizes differ, ...)
 };
 
