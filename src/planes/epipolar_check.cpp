@@ -76,6 +76,46 @@ cv::Vec3d homogeneous(const cv::Point2d& p) { return {p.x, p.y, 1.0}; }
 
 }  // namespace
 
+std::optional<cv::Matx33d> refineFundamental(const std::vector<cv::Point2d>& view1,
+                                             const std::vector<cv::Point2d>& view2,
+                                             double scale_px, int rounds) {
+  if (view1.size() != view2.size() || view1.size() < 8 || !(scale_px > 0.0)) return std::nullopt;
+  const cv::Matx33d T1 = normalising(view1), T2 = normalising(view2);
+  std::vector<double> w(view1.size(), 1.0);
+  cv::Matx33d F;
+  for (int round = 0; round <= rounds; ++round) {
+    cv::Matx<double, 9, 9> M = cv::Matx<double, 9, 9>::zeros();
+    for (size_t i = 0; i < view1.size(); ++i) {
+      const cv::Vec3d x = T1 * homogeneous(view1[i]), y = T2 * homogeneous(view2[i]);
+      cv::Matx<double, 9, 1> a;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) a(3 * r + c) = y[r] * x[c];
+      M += (a * a.t()) * w[i];
+    }
+    cv::Matx<double, 9, 1> values;
+    cv::Matx<double, 9, 9> vectors;
+    cv::eigen(M, values, vectors);
+    if (!(values(7) > 0.0)) return std::nullopt;  // a family of F fits
+    cv::Matx33d Fn;
+    for (int k = 0; k < 9; ++k) Fn(k / 3, k % 3) = vectors(8, k);
+    cv::Matx31d sv;
+    cv::Matx33d u, vt;
+    cv::SVD::compute(Fn, sv, u, vt);
+    Fn = u * cv::Matx33d(sv(0), 0, 0, 0, sv(1), 0, 0, 0, 0) * vt;
+    F = T2.t() * Fn * T1;
+    F *= 1.0 / cv::norm(F);
+    for (size_t i = 0; i < view1.size(); ++i) {
+      const cv::Vec3d x = homogeneous(view1[i]), y = homogeneous(view2[i]);
+      const cv::Vec3d fx = F * x, fty = F.t() * y;
+      const double den = fx[0] * fx[0] + fx[1] * fx[1] + fty[0] * fty[0] + fty[1] * fty[1];
+      const double e = y.dot(fx);
+      const double d2 = den > 0.0 ? e * e / den : 0.0;  // Sampson distance squared
+      w[i] = 1.0 / (1.0 + d2 / (scale_px * scale_px));
+    }
+  }
+  return F;
+}
+
 std::optional<cv::Matx33d> fitInducedHomography(const cv::Matx33d& H1, const cv::Vec3d& e2,
                                                 const std::vector<cv::Point2d>& from,
                                                 const std::vector<cv::Point2d>& to,

@@ -303,6 +303,53 @@ void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
   for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
 }
 
+// Model selection between each plane's own homography (8 parameters) and the best one F
+// admits on its points ([e2]x F + e2 v^T, 3 parameters; F refined by least squares on
+// RANSAC's inliers): the induced one is taken when it costs no more than the 5 parameters
+// it saves, at the label cost's price per parameter (plane_penalty / 8 x ln N). A plane
+// on few or nearly collinear points (a strip of tape) has a free homography that fits
+// them but is induced by no plane. Points are then assigned again (no refit, which would
+// undo it), and a plane that no longer pays is dropped.
+void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
+                      const std::vector<cv::Point2d>& view2, const cv::Matx33d& F0, double vote_px,
+                      const PlaneParams& params, const Energy& energy) {
+  std::vector<int> agree;
+  for (const HomographyPlane& plane : planes)
+    for (int i : plane.inliers)
+      if (epipolarLineDistance(F0, view1[i], view2[i]) < vote_px) agree.push_back(i);
+  const auto F = refineFundamental(select(view1, agree), select(view2, agree), energy.sigma);
+  if (!F) return;
+  cv::Matx31d sv;
+  cv::Matx33d u, vt;
+  cv::SVD::compute(*F, sv, u, vt);
+  const cv::Vec3d e(u(0, 2), u(1, 2), u(2, 2));  // F^T e = 0
+  const cv::Matx33d A = cv::Matx33d(0, -e[2], e[1], e[2], 0, -e[0], -e[1], e[0], 0) * *F;
+  const double price =
+      5.0 * params.plane_penalty / 8.0 * std::log(static_cast<double>(view1.size()));
+  bool replaced = false;
+  for (HomographyPlane& plane : planes) {
+    std::vector<double> w;
+    for (int i : plane.inliers) {
+      const double r = transferError(plane.H, view1[i], view2[i]) / (2.0 * plane.noise_px);
+      w.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
+    }
+    const auto Hc = fitInducedHomography(A, e, select(view1, plane.inliers),
+                                         select(view2, plane.inliers), w);
+    if (!Hc) continue;
+    HomographyPlane induced = plane;
+    induced.H = *Hc;
+    const double extra = energy.sum(induced, plane.inliers, view1, view2) -
+                         energy.sum(plane, plane.inliers, view1, view2);
+    if (extra <= price) {
+      plane.H = *Hc;
+      replaced = true;
+    }
+  }
+  if (!replaced) return;
+  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
+  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+}
+
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
 // homography a plane induces lie on their epipolar lines. F by RANSAC on the points of
 // the planes found (the outliers left out: few samples are needed and a degenerate sample,
@@ -353,6 +400,7 @@ void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::
     }
   }
   if (dropped) refineAssignment(planes, view1, view2, params, energy);
+  replaceByInduced(planes, view1, view2, *F, vote_px, params, energy);
 }
 
 }  // namespace

@@ -102,6 +102,32 @@ TEST(EpipolarCheck, LineDistance) {
   EXPECT_TRUE(std::isinf(epipolarLineDistance(cv::Matx33d::zeros(), x1, x2)));
 }
 
+TEST(EpipolarCheck, RefinesFFromTwoPlanes) {
+  Rig rig;
+  std::mt19937 rng(7);
+  std::vector<cv::Point2d> a, b;
+  rig.points(kFront, 3.0, 60, rng, a, b);
+  rig.points(kSide, 2.5, 60, rng, a, b);
+  const auto F = refineFundamental(a, b, 0.3);
+  ASSERT_TRUE(F);
+  // Every point within the noise of its epipolar line, and the true plane homographies
+  // compatible with it.
+  double worst = 0.0;
+  for (size_t i = 0; i < a.size(); ++i)
+    worst = std::max(worst, epipolarLineDistance(*F, a[i], b[i]));
+  EXPECT_LT(worst, 1.5);
+  const std::vector<cv::Point2d> probe{{100, 100}, {320, 240}, {600, 400}};
+  EXPECT_LT(epipolarTransferError(inducedBy(rig, kFront, 3.0), *F, probe), 0.5);
+  EXPECT_LT(epipolarTransferError(inducedBy(rig, kSide, 2.5), *F, probe), 0.5);
+  // A gross outlier is down-weighted.
+  a.emplace_back(300, 200);
+  b.emplace_back(50, 400);
+  const auto Fo = refineFundamental(a, b, 0.3);
+  ASSERT_TRUE(Fo);
+  EXPECT_LT(epipolarTransferError(inducedBy(rig, kFront, 3.0), *Fo, probe), 0.5);
+  EXPECT_FALSE(refineFundamental({a.begin(), a.begin() + 7}, {b.begin(), b.begin() + 7}, 0.3));
+}
+
 TEST(EpipolarCheck, InducedHomographyThroughPoints) {
   Rig rig;
   std::mt19937 rng(6);

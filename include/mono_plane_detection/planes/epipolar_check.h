@@ -31,6 +31,15 @@ double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const c
 // 0 when H^T F is skew-symmetric (plane-induced), up to 1.
 double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F);
 
+// F through the points (view 1 -> view 2: x2^T F x1 = 0) by the normalised eight-point
+// least squares, rank 2 enforced, then `rounds` re-weighted rounds (Cauchy weights on the
+// Sampson distance at scale_px): the precise F once RANSAC has found the inliers (points
+// of one plane leave a family of F: the caller checks that they span two). Nothing when
+// fewer than 8 points or a family of F fits exactly.
+std::optional<cv::Matx33d> refineFundamental(const std::vector<cv::Point2d>& view1,
+                                             const std::vector<cv::Point2d>& view2,
+                                             double scale_px, int rounds = 3);
+
 // The plane-induced homography through the points, given the homography H1 of one plane
 // and the epipole e2 of view 2 (or H1 = [e2]x F): H = H1 + e2 v^T (every homography a
 // plane induces has this form; 3 unknowns instead of 8), v by least squares on the
