@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <unistd.h>
 
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/params/param_table.h"
@@ -21,6 +22,9 @@ TEST(PlanesCfg, CommittedFileIsWhatTheTableGenerates) {
   EXPECT_EQ(text.str(), dynamicReconfigureCfg())
       << "cfg/Planes.cfg is out of date: rosrun mono_plane_detection param_table --cfg > "
          "cfg/Planes.cfg";
+  // dynamic_reconfigure runs the file; regenerating it by redirection drops the bit.
+  EXPECT_EQ(access((std::string(SOURCE_DIR) + "/cfg/Planes.cfg").c_str(), X_OK), 0)
+      << "cfg/Planes.cfg must be executable: chmod +x cfg/Planes.cfg";
 }
 
 TEST(PlanesCfg, EveryRuntimeParameterHasTheTablesTypeDefaultAndRange) {
