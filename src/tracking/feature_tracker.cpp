@@ -14,6 +14,8 @@ namespace {
 
 // Sub-pixel corner refinement, for new corners and re-anchored live ones alike.
 const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+// The short backward pass of the forward-backward check: levels 0 and 1.
+const int kShortCheckLevel = 1;
 
 bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
@@ -138,15 +140,9 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after, status, error_, window,
                            max_level, criteria, 0, params_.min_eigen_threshold);
 
+  if (params_.forward_backward_check) checkBackward(previous_pyramid, pyramid);
   std::vector<uchar>& back_status = back_status_;
   std::vector<cv::Point2f>& back = back_;
-  if (params_.forward_backward_check) {
-    back = after;
-    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back, back_status, error_, window,
-                             max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
-                             params_.min_eigen_threshold);
-    back_status.resize(before.size(), 0);
-  }
 
   const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
   for (size_t i = 0; i < previous_.size(); ++i) {
@@ -171,6 +167,65 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   }
   stats_.tracked = static_cast<int>(current_.size());
   moveLostWithImage();
+}
+
+// The forward-backward check without a second full pyramidal pass (which cost as much
+// as the forward one: measured, the per-level window set-up dominates, not the
+// iterations). Each point is tracked back from where it went, starting from where the
+// image's median motion says it came from: that start does not depend on the point's own
+// forward result, so a wrong forward track returns to the true origin of its patch, not
+// to `before`, and fails. Two levels cover the point's own motion beyond the median (up
+// to ~6 px); the points that fail this short pass get the full pyramidal pass back
+// (from where they went, as before), so a point is dropped only when that fails too.
+void FeatureTracker::checkBackward(const std::vector<cv::Mat>& previous_pyramid,
+                                   const std::vector<cv::Mat>& pyramid) {
+  const std::vector<cv::Point2f>& before = before_;
+  const std::vector<cv::Point2f>& after = after_;
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params_.max_iterations, params_.epsilon_px);
+  motion_x_.clear();
+  motion_y_.clear();
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (!status_[i]) continue;
+    motion_x_.push_back(after[i].x - before[i].x);
+    motion_y_.push_back(after[i].y - before[i].y);
+  }
+  cv::Point2f motion(0.f, 0.f);
+  if (!motion_x_.empty()) {
+    const size_t mid = motion_x_.size() / 2;
+    std::nth_element(motion_x_.begin(), motion_x_.begin() + mid, motion_x_.end());
+    std::nth_element(motion_y_.begin(), motion_y_.begin() + mid, motion_y_.end());
+    motion = cv::Point2f(motion_x_[mid], motion_y_[mid]);
+  }
+  back_.resize(after.size());
+  for (size_t i = 0; i < after.size(); ++i) back_[i] = after[i] - motion;
+  const int short_level = std::min(kShortCheckLevel, std::max(0, params_.pyramid_levels - 1));
+  cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back_, back_status_, error_, window,
+                           short_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                           params_.min_eigen_threshold);
+  back_status_.resize(before.size(), 0);
+
+  // The full pass for the forward-tracked points the short one did not bring back.
+  const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
+  recheck_index_.clear();
+  recheck_from_.clear();
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (!status_[i] || !inside(after[i], pyramid[0].size())) continue;  // lost either way
+    const cv::Point2f d = back_[i] - before[i];
+    if (back_status_[i] && d.dot(d) <= fb_max2) continue;
+    recheck_index_.push_back(static_cast<int>(i));
+    recheck_from_.push_back(after[i]);
+  }
+  if (recheck_index_.empty()) return;
+  recheck_back_ = recheck_from_;
+  cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, recheck_from_, recheck_back_,
+                           recheck_status_, error_, window, std::max(0, params_.pyramid_levels - 1),
+                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
+  for (size_t k = 0; k < recheck_index_.size(); ++k) {
+    back_[recheck_index_[k]] = recheck_back_[k];
+    back_status_[recheck_index_[k]] = recheck_status_[k];
+  }
 }
 
 // A lost point is out of view or occluded, so nothing tracks it; the median image

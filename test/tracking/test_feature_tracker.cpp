@@ -1,6 +1,7 @@
 // FeatureTracker against exact ground truth: views of a texture through known motions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
@@ -328,4 +329,45 @@ TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
     }
     EXPECT_EQ(flagged, 4) << "image " << k;
   }
+}
+
+// Something moves in front of half of the scene: the points there cannot be followed,
+// Lucas-Kanade still converges somewhere on the new texture, and the forward-backward
+// check (its short pass from the image's median motion, then the full pass) must drop
+// them, while it keeps the points of the visible half.
+TEST(FeatureTracker, ForwardBackwardCheckDropsPointsUnderAnOccluder) {
+  auto run = [](bool check) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.forward_backward_check = check;
+    FeatureTracker tracker(params);
+    tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
+    const std::vector<TrackedPoint> first = tracker.current();
+    cv::Mat second = warpView(texture(), similarity(0, {}, kCentred + cv::Point2d(3, 2)), kView);
+    const cv::Rect occluder(0, 0, kView.width / 2, kView.height);
+    const cv::Mat other = makeCornerTexture({1000, 800}, 7);
+    other(cv::Rect(100, 100, occluder.width, occluder.height)).copyTo(second(occluder));
+    const auto& points = tracker.process(second);
+    // Points well inside the occluder (its edge is still half background) and outside.
+    int hidden = 0, hidden_kept = 0, visible = 0, visible_kept = 0;
+    std::set<std::uint64_t> kept;
+    for (const auto& p : points) kept.insert(p.id);
+    for (const auto& p : first) {
+      if (p.uv.x < occluder.width - 12) {
+        ++hidden;
+        hidden_kept += static_cast<int>(kept.count(p.id));
+      } else if (p.uv.x > occluder.width + 12) {
+        ++visible;
+        visible_kept += static_cast<int>(kept.count(p.id));
+      }
+    }
+    return std::array<int, 4>{hidden, hidden_kept, visible, visible_kept};
+  };
+  const auto with = run(true), without = run(false);
+  ASSERT_GT(with[0], 40);
+  ASSERT_GT(with[2], 40);
+  EXPECT_LE(with[1], with[0] / 10) << "of " << with[0] << " hidden points";
+  EXPECT_GE(with[3], with[2] * 9 / 10) << "of " << with[2] << " visible points";
+  // Without the check many hidden points are reported tracked: the test can fail.
+  EXPECT_GT(without[1], with[1] + with[0] / 4) << without[1] << " of " << without[0];
 }

@@ -128,6 +128,8 @@ class FeatureTracker {
 
   void trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
                          const std::vector<cv::Mat>& pyramid, const cv::Size& size);
+  void checkBackward(const std::vector<cv::Mat>& previous_pyramid,
+                     const std::vector<cv::Mat>& pyramid);
   void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
   void reanchor(const cv::Mat& gray);
   void moveLostWithImage();
@@ -152,6 +154,9 @@ class FeatureTracker {
   std::vector<cv::Point2f> before_, after_, back_, live_uv_, fresh_uv_;
   std::vector<uchar> status_, back_status_;
   std::vector<float> error_, motion_x_, motion_y_;
+  std::vector<int> recheck_index_;
+  std::vector<cv::Point2f> recheck_from_, recheck_back_;
+  std::vector<uchar> recheck_status_;
   std::vector<TrackedPoint> fresh_;
   CornerSearchBuffers search_buffers_;
   cv::Size image_size_;
