@@ -151,7 +151,7 @@ RowResult runRow(const Sequence& seq, int features) {
     const std::vector<TrackedPoint>* state = nullptr;
     ours.measure(k, [&] {
       state = &tracker.process(seq.images[k]);
-      return tracker.lastStats().searched;
+      return tracker.lastStats().searched || tracker.lastStats().search_rest;
     });
     floor.measure(k, [&] {
       if (k % 10 == 0 || points.size() < static_cast<size_t>(features) / 3) {

@@ -371,3 +371,38 @@ TEST(FeatureTracker, ForwardBackwardCheckDropsPointsUnderAnOccluder) {
   // Without the check many hidden points are reported tracked: the test can fail.
   EXPECT_GT(without[1], with[1] + with[0] / 4) << without[1] << " of " << without[0];
 }
+
+// A search is spread over search_spread_images images, a band of rows on each from the
+// top: new corners appear in the upper third on the search image, the middle third on
+// the next, the lower third on the one after, and only there.
+TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
+  TrackerParams params;
+  params.max_features = 150;
+  ASSERT_EQ(params.search_spread_images, 3);
+  FeatureTracker tracker(params);
+  const auto hs = translations(35, kCentred, {4.0, 0.0});  // points leave at the side
+  const float third = kView.height / 3.0f;
+  int parts_seen[4] = {0, 0, 0, 0};
+  int part = 0;
+  for (size_t k = 0; k < hs.size(); ++k) {
+    const auto& points = tracker.process(warpView(texture(), hs[k], kView));
+    const auto& stats = tracker.lastStats();
+    if (k == 0) continue;  // the first image searches the whole image
+    part = stats.searched ? 1 : stats.search_rest ? part + 1 : 0;
+    ASSERT_LE(part, 3) << "image " << k;
+    int fresh = 0;
+    for (const auto& p : points) {
+      if (!p.is_new) continue;
+      ++fresh;
+      ASSERT_GT(part, 0) << "new corner on image " << k << " without a search";
+      EXPECT_GE(p.uv.y, (part - 1) * third - 1.0f) << "image " << k << ", part " << part;
+      EXPECT_LT(p.uv.y, part * third + 1.0f) << "image " << k << ", part " << part;
+    }
+    parts_seen[part] += fresh > 0;
+    if (part == 3) EXPECT_GE(points.size(), 140u) << "image " << k;  // refilled
+  }
+  EXPECT_GE(parts_seen[1], 2);
+  EXPECT_GE(parts_seen[2], 2);
+  EXPECT_GE(parts_seen[3], 2);
+  EXPECT_EQ(parts_seen[0], 0);
+}
