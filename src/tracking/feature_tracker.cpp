@@ -290,7 +290,7 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   if (part > 0) wanted = (wanted + parts - part) / (parts - part + 1);
   // A coarse level that came up short (the image's corners are fine-grained, or more
   // are wanted than it holds) costs a second search at full resolution: search there
-  // directly, and try the coarse level again every fourth search.
+  // directly, and try the coarse level again every fourth search (band).
   const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
   const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
@@ -327,8 +327,8 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 
   // One ORB call for the live points and the new corners: the new corners' part is
   // compared with the lost points, and all are remembered for when they get lost.
-  // (Of the live points, those in the band: the other half is described on the other
-  // image of the search.)
+  // (Of the live points, those in the band: the others are described on the other
+  // images of the search.)
   std::vector<cv::Mat> descriptors;
   described_.clear();
   if (params_.reidentify) {
