@@ -98,6 +98,8 @@ const ParamTable<TrackerParams>& trackerParamTable() {
        "search again when this share of the last search's points is lost (paper: 2/3)"},
       {"redetect_every", field(&P::redetect_every), 1, 100000, "images",
        "search again at the latest after this many images (paper: 10)"},
+      {"search_spread_images", field(&P::search_spread_images), 1, 10, "images",
+       "a search runs over this many images, a band of rows on each (1: the whole image)"},
       {"match_radius_px", field(&P::match_radius_px), 0, 100, "px",
        "a new corner this close to a live point is that point (paper II-D)"},
       {"forward_backward_check", field(&P::forward_backward_check), 0, 1, "",

@@ -50,12 +50,20 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,
                                             CornerSearchBuffers& buffers,
-                                            const cv::Mat* derivatives) {
+                                            const cv::Mat* derivatives, const cv::Rect& band) {
   std::vector<cv::Point2f>& corners = buffers.corners;
   corners.clear();
   buffers.from_full_resolution = 0;
   if (wanted <= 0) return corners;
   const float scale = static_cast<float>(1 << level);
+  // The band on this level (whole rows of it: the band's edges are rows).
+  const cv::Rect whole(0, 0, level_image.cols, level_image.rows);
+  const cv::Rect on_level =
+      band.empty() ? whole
+                   : cv::Rect(0, band.y >> level, level_image.cols,
+                              ((band.y + band.height + (1 << level) - 1) >> level) - (band.y >> level)) &
+                         whole;
+  if (on_level.empty()) return corners;
   const double min_distance = params.min_distance_px / scale;
   cv::Mat mask;
   if (!live.empty()) {
@@ -71,10 +79,13 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   // search finds the same corners again (paper II-D keeps ids by finding them again).
   const bool rank = level > 0 && derivatives != nullptr;
   const int ask = rank ? 3 * wanted + 8 : wanted;
-  cv::goodFeaturesToTrack(level_image, corners, ask, params.quality_level, min_distance, mask,
-                          params.block_size);
+  // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
+  // the scores at the band's edge are those of the whole image.)
+  cv::goodFeaturesToTrack(level_image(on_level), corners, ask, params.quality_level, min_distance,
+                          mask.empty() ? mask : mask(on_level), params.block_size);
   if (corners.empty()) return corners;
-  for (auto& c : corners) c *= scale;  // pyrDown keeps pixel 2i of the finer level at i
+  const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
+  for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
   // Score: the best of the pixel nearest the corner and its 8 neighbours (a corner found
   // by goodFeaturesToTrack is its neighbourhood's maximum).
   auto score = [&](const cv::Point2f& c, int block) {
@@ -107,6 +118,19 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                 corners.end());
   // Then by the score where the corner really is, as a full-resolution search would.
   if (rank) rankBy(params.block_size, corners.size());
+  // goodFeaturesToTrack's quality_level is relative to the best corner it sees: in a band,
+  // the band's best. The bar of a search of the whole image is set by the best corner
+  // found or live instead.
+  if (derivatives != nullptr && !band.empty()) {
+    double best = 0;
+    for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
+    for (const auto& c : live) best = std::max(best, score(c, params.block_size));
+    corners.erase(std::remove_if(corners.begin(), corners.end(),
+                                 [&](const cv::Point2f& c) {
+                                   return score(c, params.block_size) < params.quality_level * best;
+                                 }),
+                  corners.end());
+  }
   keepApart(corners, live, params.min_distance_px, wanted);
   if (rank && static_cast<int>(corners.size()) < wanted) {
     // The coarse level holds fewer corners than wanted (fine texture fades there): the
@@ -121,7 +145,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
     taken = live;
     taken.insert(taken.end(), corners.begin(), corners.end());
     std::vector<cv::Point2f> found = std::move(corners);
-    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers);
+    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers,
+                nullptr, band);
     const size_t coarse = found.size();
     for (const auto& c : buffers.corners)
       if (score(c, params.block_size) >= params.quality_level * best) found.push_back(c);

@@ -14,21 +14,33 @@ namespace {
 
 // Sub-pixel corner refinement, for new corners and re-anchored live ones alike.
 const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
+// The short backward pass of the forward-backward check: levels 0 and 1.
+const int kShortCheckLevel = 1;
 
 bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
 }
 
 // ORB descriptors at given positions; a point too close to the border for ORB's patch
-// gets an empty descriptor.
+// gets an empty descriptor. ORB blurs the whole image it is given: it gets the region
+// around the points only (half a search's points fill half the image), with a margin
+// beyond its patch and blur so that the descriptors are those of the whole image.
 std::vector<cv::Mat> orbDescriptors(const cv::Mat& gray, const std::vector<cv::Point2f>& uv) {
   static thread_local cv::Ptr<cv::ORB> orb = cv::ORB::create(500, 1.2f, /*nlevels=*/1);
+  if (uv.empty()) return {};
+  const int margin = orb->getEdgeThreshold() + 8;
+  cv::Rect region = cv::boundingRect(uv);
+  region = cv::Rect(region.x - margin, region.y - margin, region.width + 2 * margin,
+                    region.height + 2 * margin) &
+           cv::Rect(0, 0, gray.cols, gray.rows);
+  // Points within the margin of the image's own border are left out by ORB either way.
+  const cv::Point2f offset(static_cast<float>(region.x), static_cast<float>(region.y));
   std::vector<cv::KeyPoint> keypoints;
   for (size_t i = 0; i < uv.size(); ++i) {
-    keypoints.emplace_back(uv[i], 31.f, 0.f, 0.f, 0, static_cast<int>(i));
+    keypoints.emplace_back(uv[i] - offset, 31.f, 0.f, 0.f, 0, static_cast<int>(i));
   }
   cv::Mat rows;
-  orb->compute(gray, keypoints, rows);
+  orb->compute(gray(region), keypoints, rows);
   std::vector<cv::Mat> out(uv.size());
   for (size_t k = 0; k < keypoints.size(); ++k) {
     out[keypoints[k].class_id] = rows.row(static_cast<int>(k)).clone();
@@ -52,6 +64,7 @@ void FeatureTracker::reset() {
   frames_since_search_ = 0;
   coarse_came_short_ = false;
   searches_at_full_ = 0;
+  next_search_part_ = 0;
 }
 
 int minimumImageSide(const TrackerParams& params) {
@@ -91,9 +104,18 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
 
   // Paper II-D: the search runs on this image, before the next one is loaded, so the
   // points still tracked here continue into the new set.
+  // A search costs a few images' tracking (at 320x240 a full-resolution corner search
+  // costs 2-3 images' Lucas-Kanade): it is spread over search_spread_images images, a
+  // band of rows on each from the top down, so that no image costs much more than the
+  // others. (Whole on the first image, when nothing is left, and in paper mode without
+  // the mask, where a search re-finds every live point's corner.)
   if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()), frames_since_search_,
                    params_)) {
-    search(gray, pyramid);
+    const bool spread =
+        params_.mask_existing && !current_.empty() && params_.search_spread_images > 1;
+    search(gray, pyramid, spread ? 1 : 0);
+  } else if (next_search_part_ > 0) {
+    search(gray, pyramid, next_search_part_);
   }
   has_previous_pyramid_ = true;
   pyramid_now_ = 1 - pyramid_now_;
@@ -138,15 +160,9 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after, status, error_, window,
                            max_level, criteria, 0, params_.min_eigen_threshold);
 
+  if (params_.forward_backward_check) checkBackward(previous_pyramid, pyramid);
   std::vector<uchar>& back_status = back_status_;
   std::vector<cv::Point2f>& back = back_;
-  if (params_.forward_backward_check) {
-    back = after;
-    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back, back_status, error_, window,
-                             max_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
-                             params_.min_eigen_threshold);
-    back_status.resize(before.size(), 0);
-  }
 
   const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
   for (size_t i = 0; i < previous_.size(); ++i) {
@@ -173,6 +189,65 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   moveLostWithImage();
 }
 
+// The forward-backward check without a second full pyramidal pass (which cost as much
+// as the forward one: measured, the per-level window set-up dominates, not the
+// iterations). Each point is tracked back from where it went, starting from where the
+// image's median motion says it came from: that start does not depend on the point's own
+// forward result, so a wrong forward track returns to the true origin of its patch, not
+// to `before`, and fails. Two levels cover the point's own motion beyond the median (up
+// to ~6 px); the points that fail this short pass get the full pyramidal pass back
+// (from where they went, as before), so a point is dropped only when that fails too.
+void FeatureTracker::checkBackward(const std::vector<cv::Mat>& previous_pyramid,
+                                   const std::vector<cv::Mat>& pyramid) {
+  const std::vector<cv::Point2f>& before = before_;
+  const std::vector<cv::Point2f>& after = after_;
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params_.max_iterations, params_.epsilon_px);
+  motion_x_.clear();
+  motion_y_.clear();
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (!status_[i]) continue;
+    motion_x_.push_back(after[i].x - before[i].x);
+    motion_y_.push_back(after[i].y - before[i].y);
+  }
+  cv::Point2f motion(0.f, 0.f);
+  if (!motion_x_.empty()) {
+    const size_t mid = motion_x_.size() / 2;
+    std::nth_element(motion_x_.begin(), motion_x_.begin() + mid, motion_x_.end());
+    std::nth_element(motion_y_.begin(), motion_y_.begin() + mid, motion_y_.end());
+    motion = cv::Point2f(motion_x_[mid], motion_y_[mid]);
+  }
+  back_.resize(after.size());
+  for (size_t i = 0; i < after.size(); ++i) back_[i] = after[i] - motion;
+  const int short_level = std::min(kShortCheckLevel, std::max(0, params_.pyramid_levels - 1));
+  cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back_, back_status_, error_, window,
+                           short_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                           params_.min_eigen_threshold);
+  back_status_.resize(before.size(), 0);
+
+  // The full pass for the forward-tracked points the short one did not bring back.
+  const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
+  recheck_index_.clear();
+  recheck_from_.clear();
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (!status_[i] || !inside(after[i], pyramid[0].size())) continue;  // lost either way
+    const cv::Point2f d = back_[i] - before[i];
+    if (back_status_[i] && d.dot(d) <= fb_max2) continue;
+    recheck_index_.push_back(static_cast<int>(i));
+    recheck_from_.push_back(after[i]);
+  }
+  if (recheck_index_.empty()) return;
+  recheck_back_ = recheck_from_;
+  cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, recheck_from_, recheck_back_,
+                           recheck_status_, error_, window, std::max(0, params_.pyramid_levels - 1),
+                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
+  for (size_t k = 0; k < recheck_index_.size(); ++k) {
+    back_[recheck_index_[k]] = recheck_back_[k];
+    back_status_[recheck_index_[k]] = recheck_status_[k];
+  }
+}
+
 // A lost point is out of view or occluded, so nothing tracks it; the median image
 // motion of the live points is the best guess of where it went (it follows camera
 // rotation, the paper's case of points leaving and coming back).
@@ -194,15 +269,28 @@ void FeatureTracker::moveLostWithImage() {
   for (auto& l : lost_) l.uv += motion;
 }
 
-void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid) {
-  stats_.searched = true;
-  if (params_.reanchor_on_search) reanchor(gray);
-  const int wanted = params_.mask_existing
-                         ? params_.max_features - static_cast<int>(current_.size())
-                         : params_.max_features;
+// part 0: the whole image; 1..search_spread_images: that band of rows, from the top.
+void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part) {
+  const int parts = std::max(1, params_.search_spread_images);
+  const int top = (part - 1) * gray.rows / parts, bottom = part * gray.rows / parts;
+  const cv::Rect band = part == 0 ? cv::Rect() : cv::Rect(0, top, gray.cols, bottom - top);
+  auto in_band = [&](const cv::Point2f& p) {
+    return band.empty() || (p.y >= band.y && p.y < band.y + band.height);
+  };
+  if (part > 1) {
+    stats_.search_rest = true;
+  } else {
+    stats_.searched = true;
+  }
+  next_search_part_ = part > 0 && part < parts ? part + 1 : 0;
+  if (params_.reanchor_on_search) reanchor(gray, in_band);
+  int wanted = params_.mask_existing ? params_.max_features - static_cast<int>(current_.size())
+                                     : params_.max_features;
+  // Each band takes its share of what is still missing; the last, all of it.
+  if (part > 0) wanted = (wanted + parts - part) / (parts - part + 1);
   // A coarse level that came up short (the image's corners are fine-grained, or more
   // are wanted than it holds) costs a second search at full resolution: search there
-  // directly, and try the coarse level again every fourth search.
+  // directly, and try the coarse level again every fourth search (band).
   const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
   const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
@@ -211,7 +299,7 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   const size_t per_level = pyramid.size() / (levels_built_ + 1);
   const std::vector<cv::Point2f>& corners =
       findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
-                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr);
+                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr, band);
 
   // Matched corners are the same physical point as a live one: the live point keeps
   // its id and its sub-pixel tracked position.
@@ -239,15 +327,24 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 
   // One ORB call for the live points and the new corners: the new corners' part is
   // compared with the lost points, and all are remembered for when they get lost.
+  // (Of the live points, those in the band: the others are described on the other
+  // images of the search.)
   std::vector<cv::Mat> descriptors;
+  described_.clear();
   if (params_.reidentify) {
-    positionsOf(current_, live_uv_);
+    live_uv_.clear();
+    for (size_t i = 0; i < current_.size(); ++i) {
+      if (!in_band(current_[i].uv)) continue;
+      described_.push_back(static_cast<int>(i));
+      live_uv_.push_back(current_[i].uv);
+    }
     for (const auto& p : fresh) live_uv_.push_back(p.uv);
     descriptors = orbDescriptors(gray, live_uv_);
-    const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + current_.size(),
+    const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + described_.size(),
                                                  descriptors.end());
     reidentify(fresh_descriptors, fresh);
   }
+  const size_t first_fresh = current_.size();
   for (auto& p : fresh) {
     if (!p.is_reidentified) {
       p.id = next_id_++;
@@ -255,9 +352,13 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
     }
     current_.push_back(p);
   }
-  if (params_.reidentify) refreshDescriptors(descriptors);
+  if (params_.reidentify) {
+    for (size_t k = first_fresh; k < current_.size(); ++k)
+      described_.push_back(static_cast<int>(k));
+    refreshDescriptors(descriptors);
+  }
   found_at_last_search_ = static_cast<int>(current_.size());
-  frames_since_search_ = 0;
+  if (part <= 1) frames_since_search_ = 0;
 }
 
 // Lucas-Kanade with a translation-only window follows the centroid of the window's
@@ -266,15 +367,24 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 // corner at each search bounds the drift to the images between searches. (Spreading it
 // over the images, a share of the points on each, was measured: errors grew by up to
 // half on real textures and the search image's time hardly changed.)
-void FeatureTracker::reanchor(const cv::Mat& gray) {
-  if (current_.empty()) return;
-  std::vector<cv::Point2f>& refined = positionsOf(current_, live_uv_);
+template <class InBand>
+void FeatureTracker::reanchor(const cv::Mat& gray, const InBand& in_band) {
+  described_.clear();
+  live_uv_.clear();
+  for (size_t i = 0; i < current_.size(); ++i) {
+    if (!in_band(current_[i].uv)) continue;
+    described_.push_back(static_cast<int>(i));
+    live_uv_.push_back(current_[i].uv);
+  }
+  if (live_uv_.empty()) return;
+  std::vector<cv::Point2f>& refined = live_uv_;
   const int half = params_.reanchor_window_px;
   cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1), kSubPixCriteria);
   const double max_shift2 = params_.reanchor_max_shift_px * params_.reanchor_max_shift_px;
-  for (size_t i = 0; i < current_.size(); ++i) {
-    const cv::Point2f d = refined[i] - current_[i].uv;
-    if (d.dot(d) <= max_shift2 && inside(refined[i], gray.size())) current_[i].uv = refined[i];
+  for (size_t k = 0; k < described_.size(); ++k) {
+    TrackedPoint& point = current_[described_[k]];
+    const cv::Point2f d = refined[k] - point.uv;
+    if (d.dot(d) <= max_shift2 && inside(refined[k], gray.size())) point.uv = refined[k];
   }
 }
 
@@ -342,10 +452,15 @@ void FeatureTracker::reidentify(const std::vector<cv::Mat>& descriptors,
   lost_ = std::move(kept);
 }
 
+// descriptors[k] belongs to current_[described_[k]]; the other live points keep theirs.
 void FeatureTracker::refreshDescriptors(const std::vector<cv::Mat>& descriptors) {
-  descriptors_.clear();
-  for (size_t i = 0; i < current_.size(); ++i) {
-    if (!descriptors[i].empty()) descriptors_[current_[i].id] = descriptors[i];
+  for (size_t k = 0; k < described_.size(); ++k) {
+    const std::uint64_t id = current_[described_[k]].id;
+    if (descriptors[k].empty()) {
+      descriptors_.erase(id);
+    } else {
+      descriptors_[id] = descriptors[k];
+    }
   }
 }
 

@@ -207,3 +207,34 @@ TEST(CornerSearch, FillKeepsTheQualityBarOfTheWholeImage) {
   for (const auto& c : corners) EXPECT_LT(c.x, 340) << c;
   EXPECT_EQ(buffers.from_full_resolution, 0);
 }
+
+// A band of rows searches those rows only; the two halves of an image together find
+// what one search of the whole image finds (the quality bar is the best corner found or
+// live, not the band's own best).
+TEST(CornerSearch, BandsOfRowsTogetherFindWhatTheWholeImageHolds) {
+  const Squares truth = squares({640, 480});
+  int levels = 0;
+  const auto pyramid = pyramidOf(truth.image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  const size_t whole =
+      findCorners(truth.image, pyramid[2], 1, {}, 1000, params, buffers, &pyramid[1]).size();
+  ASSERT_GT(whole, 100u);
+  std::vector<cv::Point2f> found;
+  for (const cv::Rect band : {cv::Rect(0, 0, 640, 240), cv::Rect(0, 240, 640, 240)}) {
+    const auto& corners = findCorners(truth.image, pyramid[2], 1, found, 1000, params, buffers,
+                                      &pyramid[1], band);
+    ASSERT_FALSE(corners.empty());
+    for (const auto& c : corners) {
+      EXPECT_GE(c.y, band.y - 1.0f);  // (refinement moves a corner by less than a pixel)
+      EXPECT_LT(c.y, band.y + band.height + 1.0f);
+      EXPECT_LT(nearest(c, truth.corners), 0.5);
+    }
+    found.insert(found.end(), corners.begin(), corners.end());
+  }
+  EXPECT_EQ(found.size(), whole);
+  // A band off the image finds nothing.
+  EXPECT_TRUE(findCorners(truth.image, pyramid[2], 1, {}, 50, params, buffers, &pyramid[1],
+                          cv::Rect(0, 600, 640, 100))
+                  .empty());
+}

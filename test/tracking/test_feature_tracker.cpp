@@ -1,6 +1,7 @@
 // FeatureTracker against exact ground truth: views of a texture through known motions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
@@ -328,4 +329,80 @@ TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
     }
     EXPECT_EQ(flagged, 4) << "image " << k;
   }
+}
+
+// Something moves in front of half of the scene: the points there cannot be followed,
+// Lucas-Kanade still converges somewhere on the new texture, and the forward-backward
+// check (its short pass from the image's median motion, then the full pass) must drop
+// them, while it keeps the points of the visible half.
+TEST(FeatureTracker, ForwardBackwardCheckDropsPointsUnderAnOccluder) {
+  auto run = [](bool check) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.forward_backward_check = check;
+    FeatureTracker tracker(params);
+    tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
+    const std::vector<TrackedPoint> first = tracker.current();
+    cv::Mat second = warpView(texture(), similarity(0, {}, kCentred + cv::Point2d(3, 2)), kView);
+    const cv::Rect occluder(0, 0, kView.width / 2, kView.height);
+    const cv::Mat other = makeCornerTexture({1000, 800}, 7);
+    other(cv::Rect(100, 100, occluder.width, occluder.height)).copyTo(second(occluder));
+    const auto& points = tracker.process(second);
+    // Points well inside the occluder (its edge is still half background) and outside.
+    int hidden = 0, hidden_kept = 0, visible = 0, visible_kept = 0;
+    std::set<std::uint64_t> kept;
+    for (const auto& p : points) kept.insert(p.id);
+    for (const auto& p : first) {
+      if (p.uv.x < occluder.width - 12) {
+        ++hidden;
+        hidden_kept += static_cast<int>(kept.count(p.id));
+      } else if (p.uv.x > occluder.width + 12) {
+        ++visible;
+        visible_kept += static_cast<int>(kept.count(p.id));
+      }
+    }
+    return std::array<int, 4>{hidden, hidden_kept, visible, visible_kept};
+  };
+  const auto with = run(true), without = run(false);
+  ASSERT_GT(with[0], 40);
+  ASSERT_GT(with[2], 40);
+  EXPECT_LE(with[1], with[0] / 10) << "of " << with[0] << " hidden points";
+  EXPECT_GE(with[3], with[2] * 9 / 10) << "of " << with[2] << " visible points";
+  // Without the check many hidden points are reported tracked: the test can fail.
+  EXPECT_GT(without[1], with[1] + with[0] / 4) << without[1] << " of " << without[0];
+}
+
+// A search is spread over search_spread_images images, a band of rows on each from the
+// top: new corners appear in the upper third on the search image, the middle third on
+// the next, the lower third on the one after, and only there.
+TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
+  TrackerParams params;
+  params.max_features = 150;
+  ASSERT_EQ(params.search_spread_images, 3);
+  FeatureTracker tracker(params);
+  const auto hs = translations(35, kCentred, {4.0, 0.0});  // points leave at the side
+  const float third = kView.height / 3.0f;
+  int parts_seen[4] = {0, 0, 0, 0};
+  int part = 0;
+  for (size_t k = 0; k < hs.size(); ++k) {
+    const auto& points = tracker.process(warpView(texture(), hs[k], kView));
+    const auto& stats = tracker.lastStats();
+    if (k == 0) continue;  // the first image searches the whole image
+    part = stats.searched ? 1 : stats.search_rest ? part + 1 : 0;
+    ASSERT_LE(part, 3) << "image " << k;
+    int fresh = 0;
+    for (const auto& p : points) {
+      if (!p.is_new) continue;
+      ++fresh;
+      ASSERT_GT(part, 0) << "new corner on image " << k << " without a search";
+      EXPECT_GE(p.uv.y, (part - 1) * third - 1.0f) << "image " << k << ", part " << part;
+      EXPECT_LT(p.uv.y, part * third + 1.0f) << "image " << k << ", part " << part;
+    }
+    parts_seen[part] += fresh > 0;
+    if (part == 3) EXPECT_GE(points.size(), 140u) << "image " << k;  // refilled
+  }
+  EXPECT_GE(parts_seen[1], 2);
+  EXPECT_GE(parts_seen[2], 2);
+  EXPECT_GE(parts_seen[3], 2);
+  EXPECT_EQ(parts_seen[0], 0);
 }

@@ -44,11 +44,15 @@ double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int bloc
 // from the live points, which also mask the search. At most `wanted`. On a coarse level,
 // three times as many candidates are ranked again by shiTomasiScore on `derivatives`
 // (full resolution's, CV_16SC2) when given, and the best refined. When the coarse level
-// holds fewer than `wanted`, full resolution gives the rest.
+// holds fewer than `wanted`, full resolution gives the rest. A non-empty `band` (rows of
+// `full`; its x and width are ignored) limits the search to those rows (the tracker
+// spreads a search over two images, a half on each); the quality bar is then set by the
+// best corner found or live (needs `derivatives`), not the band's best.
 const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,
                                             CornerSearchBuffers& buffers,
-                                            const cv::Mat* derivatives = nullptr);
+                                            const cv::Mat* derivatives = nullptr,
+                                            const cv::Rect& band = cv::Rect());
 
 }  // namespace mono_plane_detection

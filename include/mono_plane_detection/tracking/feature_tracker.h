@@ -31,6 +31,9 @@ struct TrackerParams {
   // When to search again (paper II-C).
   double redetect_lost_fraction = 2.0 / 3.0;  // of the points found at the last search
   int redetect_every = 10;                    // frames between searches at the latest
+  // Beyond the paper: a search runs over this many images, a band of rows on each, so
+  // that the search image does not cost several images' tracking (1: all at once).
+  int search_spread_images = 3;
 
   // Matching new corners to existing points (paper II-D).
   double match_radius_px = 3.0;
@@ -69,7 +72,8 @@ struct TrackerFrameStats {
   int added = 0;         // points with a new id
   int matched = 0;       // new corners that matched a live point (kept its id)
   int reidentified = 0;  // new corners that got back a lost id
-  bool searched = false;
+  bool searched = false;     // a search started on this image (the paper's search image)
+  bool search_rest = false;  // a later band of a search started on an earlier image
 };
 
 // Paper II-C: search again when the share of points lost since the last search reaches
@@ -128,8 +132,11 @@ class FeatureTracker {
 
   void trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
                          const std::vector<cv::Mat>& pyramid, const cv::Size& size);
-  void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
-  void reanchor(const cv::Mat& gray);
+  void checkBackward(const std::vector<cv::Mat>& previous_pyramid,
+                     const std::vector<cv::Mat>& pyramid);
+  void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part);
+  template <class InBand>
+  void reanchor(const cv::Mat& gray, const InBand& in_band);
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
@@ -152,6 +159,10 @@ class FeatureTracker {
   std::vector<cv::Point2f> before_, after_, back_, live_uv_, fresh_uv_;
   std::vector<uchar> status_, back_status_;
   std::vector<float> error_, motion_x_, motion_y_;
+  std::vector<int> recheck_index_;
+  std::vector<cv::Point2f> recheck_from_, recheck_back_;
+  std::vector<uchar> recheck_status_;
+  std::vector<int> described_;  // indices into current_ of the points re-anchored / described
   std::vector<TrackedPoint> fresh_;
   CornerSearchBuffers search_buffers_;
   cv::Size image_size_;
@@ -161,6 +172,7 @@ class FeatureTracker {
   int frames_since_search_ = 0;
   bool coarse_came_short_ = false;  // the last coarse search needed full resolution too
   int searches_at_full_ = 0;        // searches since, at full resolution
+  int next_search_part_ = 0;  // the band of a spread search the next image runs, 0: none
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
   std::vector<LostPoint> lost_;                             // re-identification pool
 };
