@@ -378,7 +378,7 @@ TEST(FeatureTracker, ForwardBackwardCheckDropsPointsUnderAnOccluder) {
 TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
   TrackerParams params;
   params.max_features = 150;
-  ASSERT_EQ(params.search_spread_images, 3);
+  params.search_spread_images = 3;
   FeatureTracker tracker(params);
   const auto hs = translations(35, kCentred, {4.0, 0.0});  // points leave at the side
   const float third = kView.height / 3.0f;

@@ -32,8 +32,9 @@ struct TrackerParams {
   double redetect_lost_fraction = 2.0 / 3.0;  // of the points found at the last search
   int redetect_every = 10;                    // frames between searches at the latest
   // Beyond the paper: a search runs over this many images, a band of rows on each, so
-  // that the search image does not cost several images' tracking (1: all at once).
-  int search_spread_images = 3;
+  // that the search image does not cost several images' tracking (1: all at once, the
+  // default: 3 flattens frame times but keeps fewer ids, docs/tracking.md).
+  int search_spread_images = 1;
 
   // Matching new corners to existing points (paper II-D).
   double match_radius_px = 3.0;
