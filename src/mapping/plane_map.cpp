@@ -308,8 +308,11 @@ int PlaneMap::associate(const cv::Vec3d& normal, double distance,
     const double offset = meanAbsResidual(plane.normal, plane.distance, obs.points);
     if (share >= params_.min_shared_ids && parallel)
       score = 1 + share;
+    // Both ways, each plane against the other's points (as the merge rule): comparing
+    // the two distances would depend on where the map's origin is (within max_angle_deg
+    // they differ by up to sin(12 deg) x the origin's distance along the plane).
     else if (parallel && offset <= params_.max_offset_m &&
-             std::abs(distance - plane.distance) <= 2 * params_.max_offset_m)
+             meanAbsResidual(normal, distance, positions(plane)) <= 2 * params_.max_offset_m)
       score = 1 - offset / params_.max_offset_m;
     if (score > best_score) {
       best_score = score;

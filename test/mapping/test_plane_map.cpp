@@ -64,6 +64,39 @@ TEST(PlaneMap, ObservationsOfTheSamePlaneWithNewTracksAssociateByGeometry) {
   EXPECT_EQ(other[0], 2);
 }
 
+// Where the map's origin lies must not matter: with an odometry frame the robot may be
+// 30 m from it. A second look at a wall, tilted 3 deg (within max_angle_deg) about the
+// middle of the patch, with new tracks, is the same wall at either origin.
+TEST(PlaneMap, AssociationDoesNotDependOnWhereTheOriginIs) {
+  for (double along_wall_m : {0.0, 30.0}) {
+    cv::Vec3d u, v;
+    planeAxes(kWall, u, v);
+    const cv::Vec3d centre = 2.0 * kWall + along_wall_m * u;
+    auto patch = [&](const cv::Vec3d& n, std::uint64_t first_id, unsigned seed) {
+      cv::Vec3d a, b;
+      planeAxes(n, a, b);
+      std::mt19937 rng(seed);
+      std::uniform_real_distribution<double> spread(-1.0, 1.0);
+      std::normal_distribution<double> noise(0, 0.01);
+      PlaneObservation obs;
+      obs.viewpoint = centre + 2.0 * kWall + 0.2 * seed * u;
+      for (int i = 0; i < 20; ++i) {
+        obs.ids.push_back(first_id + i);
+        obs.points.push_back(centre + spread(rng) * a + spread(rng) * b + noise(rng) * n);
+      }
+      return obs;
+    };
+    const double tilt = 3.0 * CV_PI / 180;
+    const cv::Vec3d tilted = std::cos(tilt) * kWall + std::sin(tilt) * u;
+    PlaneMap map;
+    map.update({patch(kWall, 100, 1)}, 1000);
+    const auto ids = map.update({patch(tilted, 900, 2)}, 1000.1);
+    ASSERT_EQ(ids.size(), 1u);
+    EXPECT_EQ(ids[0], 1) << "origin " << along_wall_m << " m along the wall";
+    EXPECT_EQ(map.planes().size(), 1u) << "origin " << along_wall_m << " m along the wall";
+  }
+}
+
 TEST(PlaneMap, TooFewOrScatteredPointsAreRejected) {
   PlaneMap map;
   EXPECT_EQ(map.update({observe(kWall, 0.0, 100, 4, 1)}, 1000)[0], -1);

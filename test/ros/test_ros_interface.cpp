@@ -195,7 +195,9 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
   EXPECT_EQ(status.level(), diagnostic_msgs::DiagnosticStatus::OK) << status.message();
   const double hz = std::stod(rate.value("actual frequency (Hz)"));
-  EXPECT_GT(hz, 10.0);
+  // The replay's 30 Hz as the node sees it, on wall time (a loaded CI machine answered
+  // 9.4 Hz): far from the 0.03 Hz a rate read on simulated time gave.
+  EXPECT_GT(hz, 3.0);
   EXPECT_LT(hz, 60.0);
   ros::WallDuration(6.0).sleep();  // the bag is paused: no clock, no tracks
   ASSERT_TRUE(rate.waitFresh());
