@@ -16,50 +16,19 @@ double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
   return std::acos(std::max(-1.0, std::min(1.0, unit(a).dot(unit(b))))) * 180.0 / CV_PI;
 }
 
-// The floor's homography alone, from a strip of floor, fixes the motion poorly (measured:
-// 7 % scale, 4 deg tilt on the rendered room). The motion's direction comes better from
-// every track (essential matrix), the floor then only gives the scale and the down
-// direction: its tracks triangulated with that motion and fitted with a plane.
-void refineWithAllTracks(const std::vector<cv::Point2d>& first,
-                         const std::vector<cv::Point2d>& second, double focal_px,
-                         const FloorParams& params, FloorStart& out) {
-  std::vector<uchar> mask;
-  const cv::Mat E = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999,
-                                         params.max_error_px / focal_px, mask);
-  if (E.rows != 3 || E.cols != 3) return;  // several solutions or none: keep the homography's
-  cv::Mat Rm, tm;
-  cv::recoverPose(E, first, second, Rm, tm, 1.0, cv::Point2d(0, 0), mask);
-  const cv::Matx33d R(Rm);
-  const cv::Vec3d t = unit(cv::Vec3d(tm));
-  const cv::Vec3d t_h = out.second_from_first.t;
-  // The two must agree, else the essential matrix is the one in doubt.
-  const cv::Matx33d dR = R * out.second_from_first.R.t();
-  const double rotation_deg =
-      std::acos(std::max(-1.0, std::min(1.0, (dR(0, 0) + dR(1, 1) + dR(2, 2) - 1) / 2))) * 180 /
-      CV_PI;
-  if (rotation_deg > 2.0 || angleDeg(t, t_h) > 15.0) return;
-  const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
-  const cv::Matx34d P2(R(0, 0), R(0, 1), R(0, 2), t[0], R(1, 0), R(1, 1), R(1, 2), t[1], R(2, 0),
-                       R(2, 1), R(2, 2), t[2]);
-  std::vector<cv::Vec3d> floor;
-  for (int i : out.floor_points) {
-    const auto p = triangulate(P1, P2, first[i], second[i]);
-    if (p && p->depth1 > 0 && p->depth2 > 0) floor.push_back(p->x);
-  }
-  if (static_cast<int>(floor.size()) < params.min_inliers) return;
-  cv::Vec3d c(0, 0, 0);
-  for (const auto& x : floor) c += x;
-  c /= static_cast<double>(floor.size());
-  cv::Matx33d S = cv::Matx33d::zeros();
-  for (const auto& x : floor) S += (x - c) * (x - c).t();
-  cv::Mat W, U, Vt;
-  cv::SVD::compute(cv::Mat(S), W, U, Vt);
-  cv::Vec3d n(Vt.at<double>(2, 0), Vt.at<double>(2, 1), Vt.at<double>(2, 2));
-  if (n.dot(c) < 0) n = -n;
-  const double d = n.dot(c);  // in units of the motion
-  if (!(d > 0) || angleDeg(n, out.down) > 10.0) return;
-  out.down = unit(n);
-  out.second_from_first = Pose{R, t * (params.camera_height_m / d)};
+// Sampson distance of a correspondence to the epipolar geometry E (normalised units).
+double sampson(const cv::Matx33d& E, const cv::Point2d& a, const cv::Point2d& b) {
+  const cv::Vec3d x1 = ray(a), x2 = ray(b);
+  const cv::Vec3d Ex1 = E * x1, Etx2 = E.t() * x2;
+  const double e = x2.dot(Ex1);
+  const double den = Ex1[0] * Ex1[0] + Ex1[1] * Ex1[1] + Etx2[0] * Etx2[0] + Etx2[1] * Etx2[1];
+  return den > 0 ? std::abs(e) / std::sqrt(den) : 0;
+}
+
+// Where the plane n . x = d of the first camera carries a first-image point in the second.
+cv::Point2d transfer(const cv::Matx33d& H, const cv::Point2d& a) {
+  const cv::Vec3d p = H * ray(a);
+  return {p[0] / p[2], p[1] / p[2]};
 }
 
 }  // namespace
@@ -72,85 +41,181 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     out.reason = "camera height unknown";
     return out;
   }
-  if (first.size() != second.size() || static_cast<int>(first.size()) < params.min_inliers) {
+  const int n = static_cast<int>(first.size());
+  if (static_cast<int>(second.size()) != n || n < std::max(8, params.min_inliers)) {
     out.reason = "too few tracks";
     return out;
   }
+  // The motion's direction from every track (essential matrix): a strip of floor alone
+  // fixes it poorly. The tracks' noise is measured, not assumed: a first RANSAC at the
+  // largest threshold, its inliers' median Sampson error gives sigma, the second uses
+  // 3 sigma (never above max_error_px).
+  std::vector<uchar> mask;
+  cv::Mat Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999,
+                                    params.max_error_px / focal_px, mask);
+  if (Em.rows != 3 || Em.cols != 3) {
+    out.reason = "no motion between the views (essential matrix)";
+    return out;
+  }
+  std::vector<double> residuals;
+  for (int i = 0; i < n; ++i)
+    if (mask[i]) residuals.push_back(sampson(cv::Matx33d(Em), first[i], second[i]));
+  const double sigma = std::max(1.4826 * median(residuals), 0.05 / focal_px);
+  const double threshold = std::min(3 * sigma, params.max_error_px / focal_px);
+  out.noise_px = sigma * focal_px;
+  Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, threshold,
+                            mask);
+  if (Em.rows != 3 || Em.cols != 3) {
+    out.reason = "no motion between the views (essential matrix)";
+    return out;
+  }
+  cv::Mat Rm, tm;
+  cv::recoverPose(Em, first, second, Rm, tm, 1.0, cv::Point2d(0, 0), mask);
+  const cv::Matx33d R(Rm);
+  const cv::Vec3d t = unit(cv::Vec3d(tm));
+  // Each inlier's parallax (rotation removed) and its point, the motion's length 1.
+  const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
+  const cv::Matx34d P2 = projectionMatrix(R, t);
+  std::vector<int> index;
+  std::vector<cv::Vec3d> points;
+  std::vector<double> parallax_of, all_parallax;
+  for (int i = 0; i < n; ++i) {
+    if (!mask[i]) continue;
+    const double parallax = angleDeg(ray(first[i]), R.t() * ray(second[i]));
+    all_parallax.push_back(parallax);
+    const auto p = triangulate(P1, P2, first[i], second[i]);
+    if (!p || p->depth1 <= 0 || p->depth2 <= 0) continue;
+    index.push_back(i);
+    points.push_back(p->x);
+    parallax_of.push_back(parallax);
+  }
+  if (all_parallax.empty() || median(all_parallax) < 0.25 * params.min_parallax_deg) {
+    out.reason = "not enough motion yet (parallax)";
+    return out;
+  }
+  if (static_cast<int>(points.size()) < params.min_inliers) {
+    out.reason = "too few tracks triangulate";
+    return out;
+  }
+  // The floor: of the planes through three triangulated points whose normal is within
+  // max_floor_angle_deg of the nominal down, the one whose homography (H = R + t n^T / d)
+  // carries the most tracks within the noise threshold.
   const double pitch = params.pitch_down_deg * CV_PI / 180.0;
   const cv::Vec3d nominal_down(0, std::cos(pitch), std::sin(pitch));  // x right, y down, z ahead
-  std::vector<int> remaining(first.size());
-  for (size_t i = 0; i < first.size(); ++i) remaining[i] = static_cast<int>(i);
-  double best_angle = params.max_floor_angle_deg;
-  out.reason = "no plane near the nominal floor";
-  for (int plane = 0; plane < params.max_planes; ++plane) {
-    if (static_cast<int>(remaining.size()) < params.min_inliers) break;
-    std::vector<cv::Point2d> a, b;
-    for (int i : remaining) {
-      a.push_back(first[i]);
-      b.push_back(second[i]);
+  cv::RNG rng(1);  // repeatable
+  std::vector<int> best;
+  int best_telling = 0;
+  struct Hypothesis {
+    double d;
+    int telling;
+    std::vector<int> inliers;
+  };
+  std::vector<Hypothesis> hypotheses;
+  const int m = static_cast<int>(points.size());
+  // Tracks the rotation alone carries within the threshold (far, or near the direction
+  // of motion) lie on every plane: they are counted for none.
+  std::vector<bool> at_infinity(m);
+  for (int k = 0; k < m; ++k)
+    at_infinity[k] = cv::norm(transfer(R, first[index[k]]) - second[index[k]]) < 2 * threshold;
+  // Samples only from tracks below the nominal horizon that the rotation does not explain.
+  std::vector<int> candidates;
+  for (int k = 0; k < m; ++k)
+    if (!at_infinity[k] && nominal_down.dot(points[k]) > 0) candidates.push_back(k);
+  const int c = static_cast<int>(candidates.size());
+  for (int iteration = 0; iteration < 2000 && c >= 3; ++iteration) {
+    const int i0 = candidates[rng.uniform(0, c)], i1 = candidates[rng.uniform(0, c)],
+              i2 = candidates[rng.uniform(0, c)];
+    if (i0 == i1 || i1 == i2 || i0 == i2) continue;
+    cv::Vec3d normal = (points[i1] - points[i0]).cross(points[i2] - points[i0]);
+    if (cv::norm(normal) <= 0) continue;
+    normal = unit(normal);
+    double d = normal.dot(points[i0]);
+    if (d < 0) {
+      normal = -normal;
+      d = -d;
     }
-    std::vector<uchar> mask;
-    const cv::Mat Hm =
-        cv::findHomography(a, b, cv::RANSAC, params.max_error_px / focal_px, mask, 2000, 0.999);
-    if (Hm.empty()) break;
-    std::vector<int> inliers, rest;
-    for (size_t k = 0; k < remaining.size(); ++k)
-      (mask[k] ? inliers : rest).push_back(remaining[k]);
-    remaining = rest;
-    if (static_cast<int>(inliers.size()) < params.min_inliers) break;
-    // One homography for (nearly) every track: a rotation, or too little motion to
-    // tell the planes apart yet.
-    if (plane == 0 && inliers.size() * 10 >= first.size() * 9)
-      out.reason = "not enough motion yet (parallax): one homography fits the tracks";
-    std::vector<cv::Mat> Rs, ts, ns;
-    cv::decomposeHomographyMat(Hm, cv::Mat::eye(3, 3, CV_64F), Rs, ts, ns);
-    // H = R + t n^T with the plane n . x = 1 in the first camera: n is the unit normal
-    // towards the plane and t is in units of the plane's distance. Keep the solutions
-    // that put every inlier in front of both cameras.
-    // The largest plane's motion in its own distances: below 3 % the decomposition
-    // is noise (a still or only turning camera).
-    if (plane == 0) {
-      double largest_t = 0;
-      for (const cv::Mat& t : ts) largest_t = std::max(largest_t, cv::norm(t));
-      if (largest_t < 0.03) {
-        out.reason = "not enough motion yet (parallax)";
-        return out;
+    if (!(d > 0) || angleDeg(normal, nominal_down) > params.max_floor_angle_deg) continue;
+    const cv::Matx33d H = R + t * (normal / d).t();
+    std::vector<int> inliers;
+    int telling = 0;
+    for (int k = 0; k < m; ++k)
+      if (cv::norm(transfer(H, first[index[k]]) - second[index[k]]) < 2 * threshold) {
+        inliers.push_back(k);
+        telling += !at_infinity[k];
       }
+    // The floor is the lowest surface: tracks clearly beyond it (by 3 times their
+    // depth's uncertainty, depth / parallax times the noise) say the plane is not it.
+    int beyond = 0;
+    for (int k = 0; k < m; ++k) {
+      const double depth_sigma = sigma / (parallax_of[k] * CV_PI / 180.0);
+      beyond += normal.dot(points[k]) - d > 3 * depth_sigma * cv::norm(points[k]);
     }
-    for (size_t s = 0; s < Rs.size(); ++s) {
-      const cv::Matx33d R(Rs[s]);
-      const cv::Vec3d t(ts[s]), n(ns[s]);
-      int in_front = 0;
-      for (int i : inliers) {
-        const double nm = n.dot(ray(first[i]));
-        if (nm <= 0) continue;
-        const cv::Vec3d x2 = R * (ray(first[i]) / nm) + t;
-        in_front += x2[2] > 0;
-      }
-      const double angle = angleDeg(n, nominal_down);
-      if (in_front * 10 < static_cast<int>(inliers.size()) * 9) continue;
-      if (angle >= best_angle) continue;
-      // Parallax of the floor's tracks: the decomposition needs motion relative to d.
-      std::vector<double> parallax;
-      for (int i : inliers) parallax.push_back(angleDeg(ray(first[i]), R.t() * ray(second[i])));
-      best_angle = angle;
-      out.down = unit(n);
-      out.second_from_first = Pose{R, t * params.camera_height_m};
-      out.floor_points = inliers;
-      out.parallax_deg = median(parallax);
-      out.ok = true;
-    }
+    if (beyond * 5 > telling || telling < params.min_inliers) continue;
+    hypotheses.push_back({d, telling, std::move(inliers)});
+    best_telling = std::max(best_telling, telling);
   }
-  if (out.ok && out.parallax_deg >= params.min_parallax_deg) refineWithAllTracks(first, second, focal_px, params, out);
-  if (out.ok && cv::norm(out.second_from_first.t) < params.min_motion * params.camera_height_m) {
+  // A plane through tracks where the floor meets a wall, tilted to pass below the floor
+  // near the camera, has nothing beyond it either and may hold as many tracks: of the
+  // well supported planes (half the best's tracks) the floor is the highest (least d).
+  double best_d = 0;
+  for (Hypothesis& h : hypotheses)
+    if (2 * h.telling >= best_telling && (best.empty() || h.d < best_d)) {
+      best_d = h.d;
+      best = std::move(h.inliers);
+    }
+  if (best_telling < params.min_inliers) {
+    out.reason = "no plane near the nominal floor (" + std::to_string(best_telling) + " of " +
+                 std::to_string(m) + " tracks, " + std::to_string(params.min_inliers) +
+                 " needed)";
+    return out;
+  }
+  // Its plane from the image measurements of all its tracks, the motion known: m = n / d
+  // solves x2 x (R x1 + t (x1 . m)) = 0 in least squares (linear in m); then the
+  // inliers of that plane's homography, and once more.
+  cv::Vec3d m_plane(0, 0, 0);
+  for (int round = 0; round < 2; ++round) {
+    cv::Mat A(3 * static_cast<int>(best.size()), 3, CV_64F), rhs(A.rows, 1, CV_64F);
+    for (size_t j = 0; j < best.size(); ++j) {
+      const cv::Vec3d x1 = ray(first[index[best[j]]]), x2 = ray(second[index[best[j]]]);
+      const cv::Vec3d a = x2.cross(t), b = x2.cross(R * x1);
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) A.at<double>(3 * static_cast<int>(j) + r, c) = a[r] * x1[c];
+        rhs.at<double>(3 * static_cast<int>(j) + r) = -b[r];
+      }
+    }
+    cv::Mat solution;
+    if (!cv::solve(A, rhs, solution, cv::DECOMP_SVD)) break;
+    m_plane = cv::Vec3d(solution);
+    if (round == 1 || !(cv::norm(m_plane) > 0)) break;
+    const cv::Matx33d H = R + t * m_plane.t();
+    std::vector<int> again;
+    for (int k = 0; k < m; ++k)
+      if (cv::norm(transfer(H, first[index[k]]) - second[index[k]]) < 2 * threshold) again.push_back(k);
+    if (again.size() < best.size() / 2) break;  // the fit went elsewhere: keep the first
+    best = again;
+  }
+  std::vector<double> floor_parallax;
+  for (int k : best) floor_parallax.push_back(parallax_of[k]);
+  const double d = cv::norm(m_plane) > 0 ? 1.0 / cv::norm(m_plane) : 0;  // in lengths of the motion
+  const cv::Vec3d normal = m_plane * d;
+  if (!(d > 0) || angleDeg(normal, nominal_down) > params.max_floor_angle_deg) {
+    out.reason = "no plane near the nominal floor";
+    return out;
+  }
+  out.down = unit(normal);
+  out.second_from_first = Pose{R, t * (params.camera_height_m / d)};
+  out.point_index = index;
+  for (const cv::Vec3d& x : points) out.points.push_back(x * (params.camera_height_m / d));
+  for (int k : best) out.floor_points.push_back(index[k]);
+  out.parallax_deg = median(floor_parallax);
+  out.ok = true;
+  if (1.0 / d < params.min_motion) {
     out.ok = false;
     out.reason = "floor found, not enough motion yet";
-  }
-  if (out.ok && out.parallax_deg < params.min_parallax_deg) {
+  } else if (out.parallax_deg < params.min_parallax_deg) {
     out.ok = false;
     out.reason = "floor found, not enough motion yet (parallax)";
   }
-  if (out.ok) out.reason.clear();
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
 namespace mono_plane_detection {
@@ -86,7 +87,6 @@ void PoseEstimator::reset() {
   metric_ = MetricSource::kNone;
   floor_reason_.clear();
   floor_views_.clear();
-  frames_seen_ = 0;
 }
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
@@ -344,50 +344,114 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
     const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) {
   std::unordered_map<std::uint64_t, size_t> in_frame;
   for (size_t i = 0; i < frame.ids.size(); ++i) in_frame.emplace(frame.ids[i], i);
-  // Earlier views that lost most of their tracks are of no more use.
-  auto shared = [&](const FirstView& view) {
-    size_t n = 0;
-    for (auto id : view.ids) n += in_frame.count(id);
-    return n;
+  // The tracks a kept view shares with this image: first and second view coordinates.
+  struct Pair {
+    std::vector<cv::Point2d> a, b;
+    std::vector<std::uint64_t> ids;
   };
-  while (!floor_views_.empty() && shared(floor_views_.front()) * 2 < floor_views_.front().ids.size())
+  auto pair = [&](const FirstView& view) {
+    Pair p;
+    for (size_t i = 0; i < view.ids.size(); ++i) {
+      const auto it = in_frame.find(view.ids[i]);
+      if (it == in_frame.end()) continue;
+      p.ids.push_back(view.ids[i]);
+      p.a.push_back(view.normalized[i]);
+      p.b.push_back(normalized[it->second]);
+    }
+    return p;
+  };
+  // Views sharing fewer tracks than a floor needs are of no more use.
+  const size_t needed = static_cast<size_t>(std::max(8, params_.floor.min_inliers));
+  while (!floor_views_.empty() && pair(floor_views_.front()).ids.size() < needed)
     floor_views_.pop_front();
-  const bool keep = frames_seen_++ % 5 == 0;
-  if (floor_views_.empty()) {
-    floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0});
-    floor_reason_ = "waiting for camera motion";
-    return {};
+  // A new view is kept once the tracks have moved since the newest one (median image
+  // motion of 1 % of the focal length: a still camera adds none), at most 20 of them.
+  bool keep = floor_views_.empty();
+  if (!keep) {
+    const Pair p = pair(floor_views_.back());
+    std::vector<double> moved;
+    for (size_t i = 0; i < p.a.size(); ++i) moved.push_back(cv::norm(p.a[i] - p.b[i]));
+    keep = moved.empty() || median(moved) >= 0.01;
   }
-  const FirstView& view = floor_views_.front();
-  std::unordered_map<std::uint64_t, size_t> in_first;
-  for (size_t i = 0; i < view.ids.size(); ++i) in_first.emplace(view.ids[i], i);
-  std::vector<cv::Point2d> a, b;
-  std::vector<std::uint64_t> ids;
-  for (size_t i = 0; i < frame.ids.size(); ++i) {
-    const auto it = in_first.find(frame.ids[i]);
-    if (it == in_first.end()) continue;
-    ids.push_back(frame.ids[i]);
-    a.push_back(view.normalized[it->second]);
-    b.push_back(normalized[i]);
+  std::optional<FloorStart> floor;
+  Pair shared;
+  std::string reason = "waiting for camera motion";
+  // The oldest view has the most parallax but may have lost its floor tracks: up to 4
+  // views from the oldest to the newest are tried, the first that gives the floor wins.
+  const size_t views = floor_views_.size(), tries = std::min<size_t>(4, views);
+  for (size_t k = 0; k < tries && !floor; ++k) {
+    const size_t v = tries > 1 ? k * (views - 1) / (tries - 1) : 0;
+    Pair p = pair(floor_views_[v]);
+    FloorStart f = floorStart(p.a, p.b, K_(0, 0), params_.floor);
+    if (k == 0) reason = f.reason;
+    // A floor of a few tracks can be a chance plane: it must be found again, the same
+    // (down within max_floor_change_deg), in `confirmations` images in a row against the
+    // same view (measured on the rendered wheeled room: one pair's down scatters by about
+    // 2 deg and its scale by 5 %; the humanoid's chance planes change by more).
+    FirstView& view = floor_views_[v];
+    if (f.ok) {
+      const bool same = view.floor_count > 0 &&
+                        std::acos(std::min(1.0, view.floor_down.dot(f.down))) * 180 / CV_PI <
+                            params_.floor.max_floor_change_deg;
+      view.floor_count = same ? view.floor_count + 1 : 1;
+      view.floor_down = f.down;
+      if (!same) {
+        view.floor_points.clear();
+        view.floor_downs.clear();
+      }
+      std::unordered_map<std::uint64_t, cv::Vec3d> here;
+      for (size_t j = 0; j < f.point_index.size(); ++j) here.emplace(p.ids[f.point_index[j]], f.points[j]);
+      if (view.floor_count < params_.floor.confirmations) {
+        view.floor_points.push_back(std::move(here));
+        view.floor_downs.push_back(f.down);
+        if (k == 0) reason = "floor found, seen " + std::to_string(view.floor_count) + " of " +
+                                 std::to_string(params_.floor.confirmations) + " times";
+        continue;
+      }
+      // One pair's scale scatters (about 5 % on the rendered room): each earlier image's
+      // floor scaled the same tracks' points too; the median of those scales over this
+      // pair's, and the mean of the downs, are used.
+      std::vector<double> scales{1.0};
+      cv::Vec3d down = f.down;
+      for (size_t j = 0; j < view.floor_points.size(); ++j) {
+        std::vector<double> ratios;
+        for (const auto& [id, x] : here) {
+          const auto it = view.floor_points[j].find(id);
+          if (it != view.floor_points[j].end() && cv::norm(x) > 0) ratios.push_back(cv::norm(it->second) / cv::norm(x));
+        }
+        if (ratios.size() >= 8) scales.push_back(median(ratios));
+        down += view.floor_downs[j];
+      }
+      const double scale = median(scales);
+      f.second_from_first.t *= scale;
+      f.down = down / cv::norm(down);
+      view.floor_points.clear();
+      view.floor_downs.clear();
+      floor = std::move(f);
+      shared = std::move(p);
+    }
   }
   if (keep) {
-    floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0});
-    while (floor_views_.size() > 12) floor_views_.pop_front();
+    floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0, frame.stamp});
+    // Full: the second oldest goes, so the oldest (most parallax) stays while it can.
+    if (floor_views_.size() > 40) floor_views_.erase(floor_views_.begin() + 1);
   }
-  const FloorStart floor = floorStart(a, b, K_(0, 0), params_.floor);
-  if (!floor.ok) {
-    floor_reason_ = floor.reason;
+  if (!floor) {
+    floor_reason_ = reason;
     return {};
   }
+  const std::vector<cv::Point2d>& a = shared.a;
+  const std::vector<cv::Point2d>& b = shared.b;
+  const std::vector<std::uint64_t>& ids = shared.ids;
   // Every track seen in both views, triangulated with the metric motion.
-  const Pose map_from_first = floorMapFromCamera(floor.down, params_.floor.camera_height_m);
-  const Pose map_from_second = map_from_first * floor.second_from_first.inverse();
+  const Pose map_from_first = floorMapFromCamera(floor->down, params_.floor.camera_height_m);
+  const Pose map_from_second = map_from_first * floor->second_from_first.inverse();
   const cv::Matx34d P1 = projectionMatrix(cv::Matx33d::eye(), cv::Vec3d(0, 0, 0));
-  const cv::Matx34d P2 = projectionMatrix(floor.second_from_first.R, floor.second_from_first.t);
-  const double max_error = 2 * params_.floor.max_error_px / K_(0, 0);
+  const cv::Matx34d P2 = projectionMatrix(floor->second_from_first.R, floor->second_from_first.t);
+  const double max_error = 6 * floor->noise_px / K_(0, 0);  // twice the RANSAC threshold
   std::vector<int> points;
   std::vector<cv::Vec3d> points_map;
-  const cv::Matx33d R21 = floor.second_from_first.R;
+  const cv::Matx33d R21 = floor->second_from_first.R;
   for (size_t i = 0; i < ids.size(); ++i) {
     // Each point needs parallax of its own: those near the direction of motion have
     // none and would put PnP off from the first image on.
@@ -409,7 +473,7 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
   metric_ = MetricSource::kCameraHeight;
   floor_reason_.clear();
   floor_views_.clear();
-  placeStartLandmarks(frame, ids, b, points, points_map, floor.parallax_deg, map_from_second);
+  placeStartLandmarks(frame, ids, b, points, points_map, floor->parallax_deg, map_from_second);
   return PoseEstimate{map_from_second, PoseSource::kLandmarks, static_cast<int>(points.size()), 0};
 }
 

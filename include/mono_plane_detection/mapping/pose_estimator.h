@@ -130,6 +130,13 @@ class PoseEstimator {
     // homography (two_view_init.h explains why).
     std::array<cv::Point2d, 4> corner_sum{};
     int corner_count = 0;
+    double stamp = 0;
+    // camera_height: how many images in a row found the same floor against this view.
+    int floor_count = 0;
+    cv::Vec3d floor_down;
+    // The tracks' points in this view's frame (metres) by each of those images' floor.
+    std::vector<std::unordered_map<std::uint64_t, cv::Vec3d>> floor_points;
+    std::vector<cv::Vec3d> floor_downs;
   };
   FirstView firstView(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const;
 
@@ -146,10 +153,10 @@ class PoseEstimator {
   std::optional<FirstView> first_view_;
   MetricSource metric_ = MetricSource::kNone;
   std::string floor_reason_;  // why the camera_height start has not happened yet
-  // camera_height: earlier images the floor's motion is measured from (every 5th, the
-  // last 2 s), the oldest that still shares most tracks tried first (most parallax).
+  // camera_height: earlier images the floor's motion is measured from (a new one each
+  // time the tracks have moved 1 % of the focal length, at most 20), dropped when they
+  // share fewer tracks than a floor needs; the oldest is tried first (most parallax).
   std::deque<FirstView> floor_views_;
-  int frames_seen_ = 0;
 };
 
 }  // namespace mono_plane_detection
