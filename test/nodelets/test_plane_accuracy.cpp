@@ -214,7 +214,9 @@ TEST(PlaneAccuracy, RenderedSequence) {
   EXPECT_TRUE(e.missed.empty()) << e.missed.size() << " plane(s) covering >= 15 % missed";
   EXPECT_TRUE(e.split.empty()) << "a true plane has two map planes";
   for (const PlaneMatch& m : e.matches) EXPECT_GE(m.truth_id, 0) << "plane " << m.map_id;
-  if (source != "camera_height") EXPECT_LT(e.worst_normal_error_deg, 5.0);  // camera_height: below
+  if (source != "camera_height") {
+    EXPECT_LT(e.worst_normal_error_deg, 5.0);  // camera_height: below
+  }
   EXPECT_LT(e.worst_distance_error_m, 0.15);
   EXPECT_GE(position_errors.size(), 200u);
   EXPECT_LT(worst, 0.08 * truth.travelled_m);
