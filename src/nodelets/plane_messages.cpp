@@ -124,6 +124,7 @@ PlaneArrayPtr toMapPlanes(const std_msgs::Header& map_header, const PipelineResu
       const auto it = seen.find(plane.id);
       if ((it != seen.end()) != (pass == 0)) continue;
       PlaneEstimate out = toPlaneEstimate(plane);
+      out.confirmed = plane.confirmed(map.params());
       if (it != seen.end()) {
         fill(out, *it->second);
         // Under rotation every plane moves with one homography; report the tracks whose
@@ -171,6 +172,7 @@ std::string planesYaml(const PlaneArray& planes) {
         << "    normal: [" << p.normal.x << ", " << p.normal.y << ", " << p.normal.z << "]\n"
         << "    d: " << p.d << "\n"
         << "    observations: " << p.observations << "\n"
+        << "    confirmed: " << (p.confirmed ? "true" : "false") << "\n"
         << "    confidence: " << p.confidence << "\n"
         << "    polygon:\n";
     for (const auto& v : p.polygon)
@@ -230,7 +232,7 @@ visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, con
     std::ostringstream text;
     text.precision(2);
     text << planeKindName(planeKind(normal)) << " " << plane.id << " (" << plane.observations
-         << ")";
+         << (plane.confirmed(map.params()) ? ")" : ", tentative)");
     label.text = text.str();
     markers->markers.push_back(label);
   }

@@ -36,12 +36,13 @@ PlaneArrayPtr toImagePlanes(const std_msgs::Header& image_header, const Pipeline
 // A map plane as the message gives it (ROS map frame, shape_msgs sign, label).
 PlaneEstimate toPlaneEstimate(const MapPlane& plane);
 
-// Planes as YAML (~save_map): frame, stamp and per plane id, label, normal, d, polygon.
+// Planes as YAML (~save_map): frame, stamp and per plane id, label, normal, d,
+// observations, confidence, confirmed, polygon.
 std::string planesYaml(const PlaneArray& planes);
 
-// A translucent polygon, a normal arrow and a label ("wall 3 (12)") per map plane, in
-// the ROS map frame `header.frame_id`; DELETE markers for
-// planes that were published before and are gone (`shown` is updated).
+// A translucent polygon, a normal arrow and a label ("wall 3 (12)"; "wall 4 (1, tentative)"
+// until confirmed) per map plane, in the ROS map frame `header.frame_id`; DELETE markers
+// for planes that were published before and are gone (`shown` is updated).
 visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
                                              std::set<int>& shown);
 

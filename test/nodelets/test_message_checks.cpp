@@ -310,3 +310,53 @@ TEST(TrackerFrontEnd, TargetFoundAndConfirmedWithTheCameraInfo) {
   EXPECT_NE(square_front.targetRejections().find("aspect ratio "), std::string::npos)
       << square_front.targetRejections();
 }
+
+// Issue 18: `planes` lists tentative map planes too; `confirmed` (the map's own rule:
+// observations from viewpoints apart, a normal its points fix) tells them apart, in the
+// message, the saved YAML and the rviz labels.
+TEST(PlaneMessages, ConfirmedPlanesAreFlagged) {
+  PlaneMap map;
+  auto wall = [](unsigned seed, std::uint64_t first_id) {  // the wall z = 2, from 2 m
+    PlaneObservation obs;
+    obs.viewpoint = {0.3 * seed, 0, 0};
+    for (int i = 0; i < 30; ++i) {
+      obs.ids.push_back(first_id + i);
+      obs.points.push_back({-1.0 + 0.07 * i, -0.5 + (i * 7 % 10) * 0.1, 2.0});
+    }
+    return obs;
+  };
+  auto floor = [](std::uint64_t first_id) {  // y = 0.8, seen once
+    PlaneObservation obs;
+    obs.viewpoint = {0, 0, 0};
+    for (int i = 0; i < 30; ++i) {
+      obs.ids.push_back(first_id + i);
+      obs.points.push_back({-1.0 + 0.07 * i, 0.8, 1.0 + (i * 7 % 10) * 0.1});
+    }
+    return obs;
+  };
+  for (unsigned k = 0; k < 5; ++k) map.update({wall(k, 100)}, 10.0 + k);
+  map.update({floor(500)}, 15.0);
+  ASSERT_EQ(map.planes().size(), 2u);
+  std_msgs::Header header;
+  header.frame_id = "plane_map";
+  const PlaneArrayPtr msg = toMapPlanes(header, PipelineResult{}, map);
+  ASSERT_EQ(msg->planes.size(), 2u);
+  int confirmed = 0, tentative = 0;
+  for (const PlaneEstimate& p : msg->planes) {
+    const bool is_wall = p.observations >= 3;
+    EXPECT_EQ(p.confirmed, is_wall) << "plane " << p.id << ", " << p.observations << " views";
+    (p.confirmed ? confirmed : tentative) += 1;
+  }
+  EXPECT_EQ(confirmed, 1);
+  EXPECT_EQ(tentative, 1);
+  for (auto& p : msg->planes) p.metric = true;  // as in a metric image
+  const std::string yaml = planesYaml(*msg);
+  EXPECT_NE(yaml.find("confirmed: true"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("confirmed: false"), std::string::npos) << yaml;
+  std::set<int> shown;
+  int tentative_labels = 0;
+  const visualization_msgs::MarkerArrayPtr markers = toMarkers(header, map, shown);
+  for (const auto& m : markers->markers)
+    if (m.ns == "labels") tentative_labels += m.text.find("tentative") != std::string::npos;
+  EXPECT_EQ(tentative_labels, 1);
+}

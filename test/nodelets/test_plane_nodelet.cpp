@@ -195,7 +195,7 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   // and the floor (0.8 m below the target: z = -0.8, so d = 0.8 in a x + b y + c z + d = 0).
   bool wall = false, floor = false;
   for (const auto& p : last->planes) {
-    if (!p.metric || p.observations < 3) continue;
+    if (!p.metric || !p.confirmed) continue;
     const cv::Vec3d n(p.normal.x, p.normal.y, p.normal.z);
     const bool is_wall = normalAngleDeg(n, {-1, 0, 0}) < 5 && std::abs(p.d) < 0.1;
     const bool is_floor = normalAngleDeg(n, {0, 0, 1}) < 5 && std::abs(p.d - 0.8) < 0.1;
@@ -461,7 +461,9 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
     EXPECT_LT(cv::norm(at - world_->truthMapFromCamera(t).t), 0.05) << "image " << k;
     if (previous) worst_step = std::max(worst_step, cv::norm(at - *previous));
     previous = at;
-    if (k == 69) EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k == 69) {
+      EXPECT_EQ(last->status, "tracking (odometry)");
+    }
     if (k == 99) {
       EXPECT_EQ(last->status, "tracking (landmarks)");
       ASSERT_TRUE(diagnostics.waitFresh());
@@ -470,7 +472,9 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
           << diagnostics.message();
       EXPECT_EQ(diagnostics.value("metric source"), "odometry");
     }
-    if (k == 119) EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k == 119) {
+      EXPECT_EQ(last->status, "tracking (odometry)");
+    }
   }
   EXPECT_LT(worst_step, 0.05);  // 0.01 m per image
 }
@@ -572,7 +576,9 @@ TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
     tracks.publish(toTracks(f));
     last = waitFor(answers, ros::Time(f.stamp).toNSec());
     ASSERT_TRUE(last) << "image " << k << " not answered (manager gone?)";
-    if (k == 91) EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k == 91) {
+      EXPECT_EQ(last->status, "tracking (odometry)");
+    }
     if (k == 92 || k == 94) {
       EXPECT_NE(last->status, "tracking (odometry)") << "image " << k;
       if (last->metric) {

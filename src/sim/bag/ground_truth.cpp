@@ -59,10 +59,10 @@ std::optional<Pose> poseAt(const GroundTruth& truth, double stamp) {
   return {};
 }
 
-std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm) {
+std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg) {
   std::vector<MapPlane> out;
   for (const auto& p : msg.planes) {
-    if (!p.metric || static_cast<int>(p.observations) < confirm) continue;
+    if (!p.metric || !p.confirmed) continue;
     // Back from the ROS map (z up, shape_msgs sign) to the target's frame of the truth.
     const cv::Matx33d target_from_ros = rosMapFromTarget().R.t();
     MapPlane m;

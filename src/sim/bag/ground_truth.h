@@ -30,8 +30,8 @@ std::optional<Pose> poseAt(const GroundTruth& truth, double stamp);
 
 // The metric planes of a PlaneArray as map planes (id, normal, distance, polygon,
 // observations, confidence) in the core's map frame (the target's, where the truth is:
-// the message's ROS map frame and d sign undone, ros/map_frame.h); those seen fewer
-// than `confirm` times are dropped.
-std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg, int confirm = 3);
+// the message's ROS map frame and d sign undone, ros/map_frame.h); only the confirmed
+// ones (PlaneEstimate.confirmed: what a user of the topic is told to trust).
+std::vector<MapPlane> mapPlanesOf(const PlaneArray& msg);
 
 }  // namespace mono_plane_detection
