@@ -82,12 +82,16 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   const std::string error = cameraInfoError(info);
   info_size_ = error.empty() ? cv::Size(static_cast<int>(info.width), static_cast<int>(info.height))
                              : cv::Size();
-  // The sheet's aspect is judged after rectification with the camera's focal length.
-  // The tracker sees the raw image: K (camera_info semantics), not P.
-  const bool usable = error.empty() && info.K[0] > 0 && std::isfinite(info.K[0]) &&
-                      std::isfinite(info.K[2]) && std::isfinite(info.K[5]);
-  focal_px_ = usable ? info.K[0] : 0;
-  principal_px_ = usable ? cv::Point2d(info.K[2], info.K[5]) : cv::Point2d(-1, -1);
+  // The target is searched with the lens undone (straight sides) and its aspect judged
+  // with the focal length of the pixels it is searched in: a raw image's K and D, a
+  // rectified one's P (image_geometry's camera model).
+  CameraIntrinsics lens;
+  const bool usable = error.empty() && intrinsicsFromCameraInfo(info, rectified_, lens).empty();
+  const bool fisheye = usable && !lens.fisheye_D.empty();
+  focal_px_ = usable ? lens.K(0, 0) : 0;
+  principal_px_ = usable ? cv::Point2d(lens.K(0, 2), lens.K(1, 2)) : cv::Point2d(-1, -1);
+  target_startup_.setLens(usable ? lens.K : cv::Matx33d::eye(),
+                          usable ? (fisheye ? lens.fisheye_D : lens.D) : cv::Mat(), fisheye);
   return error;
 }
 

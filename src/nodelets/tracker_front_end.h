@@ -73,6 +73,9 @@ class TrackerFrontEnd {
   // Kept for its size (checked against the images); the reason when unusable.
   std::string setCameraInfo(const sensor_msgs::CameraInfo& info);
   void reset();  // nobody listens: forget everything but the counts
+  // The images are rectified (image_proc's image_rect*): camera_info's P describes them,
+  // without distortion (image_geometry); else K and D. Call before setCameraInfo.
+  void setRectified(bool rectified) { rectified_ = rectified; }
 
   const TrackerCounts& counts() const { return counts_; }
   bool hasCameraInfo() const { return !info_size_.empty(); }
@@ -96,8 +99,9 @@ class TrackerFrontEnd {
   cv::Size last_size_;
   std::string last_frame_id_;
   cv::Size info_size_;
-  double focal_px_ = 0;            // from camera_info (K), 0 when unknown
-  cv::Point2d principal_px_{-1, -1};  // from camera_info (K), negative when unknown
+  bool rectified_ = false;
+  double focal_px_ = 0;            // from camera_info (K, or P when rectified), 0 when unknown
+  cv::Point2d principal_px_{-1, -1};  // the same, negative when unknown
   uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
   uint64_t target_wait_last_ns_ = 0;
   GapCounter gaps_;

@@ -12,6 +12,7 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "callback_guard.h"
+#include "camera_info_check.h"
 #include "mono_plane_detection/viz/draw_tracks.h"
 #include "nodelet_diagnostics.h"
 #include "ros_params.h"
@@ -34,6 +35,9 @@ class TrackerNodelet : public nodelet::Nodelet {
     TrackerNodeParams params;
     readParams(pnh, trackerNodeParamTable(), params, getName());
     front_ = TrackerFrontEnd(params);
+    // image_proc's rectified stream (image_rect*): P without distortion, as the plane
+    // nodelet reads it; else the raw image's K and D (the target is searched undistorted).
+    front_.setRectified(isRectifiedTopic(nh.resolveName("image")));
 
     diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose, guard_,
                        params.expected_min_rate_hz, params.expected_max_rate_hz);

@@ -1,6 +1,8 @@
 #include "mono_plane_detection/tracking/target_startup.h"
 
 #include <algorithm>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 #include <sstream>
 #include <vector>
@@ -14,11 +16,70 @@ void TargetStartup::reset() {
   last_ = TargetDetection();
 }
 
+void TargetStartup::setLens(const cv::Matx33d& K, const cv::Mat& D, bool fisheye) {
+  const cv::Mat d = D.empty() || cv::countNonZero(D) == 0 ? cv::Mat() : D.clone();
+  // camera_info comes with every image: the maps are made again only when the lens changes.
+  const bool same = K == K_ && fisheye == fisheye_ && d.size() == D_.size() &&
+                    (d.empty() || cv::norm(d, D_, cv::NORM_INF) == 0);
+  if (same) return;
+  K_ = K;
+  D_ = d;
+  fisheye_ = fisheye;
+  map_size_ = cv::Size();
+}
+
+namespace {
+
+// Pixels of the image undistorted to K back to the raw image of the lens (K, D).
+bool toRawPixels(std::array<cv::Point2f, 4>& corners, const cv::Matx33d& K, const cv::Mat& D,
+                 bool fisheye, const cv::Size& size) {
+  std::vector<cv::Point3d> rays;
+  for (const auto& c : corners)
+    rays.emplace_back((c.x - K(0, 2)) / K(0, 0), (c.y - K(1, 2)) / K(1, 1), 1.0);
+  std::vector<cv::Point2d> raw;
+  const cv::Vec3d zero(0, 0, 0);
+  if (fisheye)
+    cv::fisheye::projectPoints(rays, raw, zero, zero, K, D);
+  else
+    cv::projectPoints(rays, zero, zero, K, D, raw);
+  const double margin = 2.0;  // px: a corner there has no surround to judge it by
+  for (int i = 0; i < 4; ++i) {
+    if (!(raw[i].x >= margin && raw[i].y >= margin && raw[i].x <= size.width - 1 - margin &&
+          raw[i].y <= size.height - 1 - margin))
+      return false;
+    corners[i] = cv::Point2f(static_cast<float>(raw[i].x), static_cast<float>(raw[i].y));
+  }
+  return true;
+}
+
+}  // namespace
+
 std::optional<TargetDetection> TargetStartup::process(const cv::Mat& gray, FeatureTracker& tracker,
                                                       double focal_px,
                                                       cv::Point2d principal_px) {
   if (found_) return {};
-  TargetDetection target = detectConfiguredTarget(gray, params_, focal_px, principal_px);
+  const bool undistort = !D_.empty() && !gray.empty();
+  if (undistort && map_size_ != gray.size()) {
+    if (fisheye_)
+      cv::fisheye::initUndistortRectifyMap(K_, D_, cv::Matx33d::eye(), K_, gray.size(), CV_16SC2,
+                                           map1_, map2_);
+    else
+      cv::initUndistortRectifyMap(K_, D_, cv::noArray(), K_, gray.size(), CV_16SC2, map1_, map2_);
+    map_size_ = gray.size();
+  }
+  if (undistort) {
+    // Replicated, not black, beyond the raw image: a black fill would be a dark surround.
+    cv::remap(gray, undistorted_, map1_, map2_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    focal_px = K_(0, 0);
+    principal_px = {K_(0, 2), K_(1, 2)};
+  }
+  TargetDetection target =
+      detectConfiguredTarget(undistort ? undistorted_ : gray, params_, focal_px, principal_px);
+  if (target.found && undistort && !toRawPixels(target.corners, K_, D_, fisheye_, gray.size())) {
+    target.found = false;
+    target.rejection = TargetRejection::kAtImageEdge;
+    target.reason = "target corners on or beyond the raw image's border";
+  }
   if (!target.found) {
     consecutive_ = 0;
     previous_.release();

@@ -26,6 +26,13 @@ class TargetStartup {
                                          double focal_px = 0,
                                          cv::Point2d principal_px = {-1, -1});
 
+  // The raw image's lens (camera_info K and D): with distortion the target is searched
+  // in the image undistorted to K, where the sheet's sides are straight lines, and its
+  // corners are given back in raw pixels. D: OpenCV's model (plumb_bob,
+  // rational_polynomial), or with fisheye the equidistant model (1 x 4); empty: none.
+  // K then also gives process() its focal length and principal point.
+  void setLens(const cv::Matx33d& K, const cv::Mat& D, bool fisheye = false);
+
   bool found() const { return found_; }
   void reset();  // search again (the tracker was reset)
   const TargetParams& params() const { return params_; }
@@ -39,6 +46,12 @@ class TargetStartup {
   int consecutive_ = 0;
   cv::Mat previous_;  // the image of the last detection, for Lucas-Kanade
   TargetDetection last_;
+  // The lens (setLens) and the undistortion maps for the last image size.
+  cv::Matx33d K_ = cv::Matx33d::eye();
+  cv::Mat D_;
+  bool fisheye_ = false;
+  cv::Size map_size_;
+  cv::Mat map1_, map2_, undistorted_;
 };
 
 }  // namespace mono_plane_detection
