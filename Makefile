@@ -99,8 +99,8 @@ eval: build
 
 # Same sources, a second workspace with sanitizers (-O1 -g1: the sanitizers' usual level,
 # line numbers in reports, quicker to compile than -O2 -g). It builds and runs the gtests
-# that need no ROS master; those CMakeLists.txt hosts in a rostest (add_rostest_gtest)
-# stay in `make test`. Any report fails the run.
+# that need no ROS master, JOBS at a time (scripts/run_sanitized.sh); those CMakeLists.txt
+# hosts in a rostest (add_rostest_gtest) stay in `make test`. Any report fails the run.
 ASAN_WS := $(REPO)/build/ws_asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 sanitize: deps
@@ -111,14 +111,7 @@ sanitize: deps
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
 	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
 	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
-	@rostest_hosted=" $$(grep -o 'add_rostest_gtest(test_[a-z0-9_]*' CMakeLists.txt | sed 's/.*(//' | tr '\n' ' ') "; \
-	passed=0; failed=0; for t in $(ASAN_WS)/devel/lib/mono_plane_detection/test_*; do \
-	  case $$(basename $$t) in *.log) continue;; esac; \
-	  case "$$rostest_hosted" in *" $$(basename $$t) "*) continue;; esac; \
-	  if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 $$t > $$t.log 2>&1; \
-	  then echo "sanitize: $$(basename $$t) clean"; passed=$$((passed + 1)); \
-	  else echo "sanitize: $$(basename $$t) FAILED"; tail -30 $$t.log; failed=$$((failed + 1)); fi; done; \
-	  echo "sanitize: $$passed passed, $$failed failed"; [ $$failed -eq 0 ] && [ $$passed -gt 0 ]
+	@scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
 
 clean:
 	rm -rf build

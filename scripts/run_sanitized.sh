@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# make sanitize's runner: every gtest binary in DIR but those CMakeLists.txt hosts in a
+# rostest (they need a ROS master and stay in `make test`), JOBS at a time (the tests'
+# temporary files carry their pid: test/support/temp_path.h). Any failure or sanitizer
+# report fails the run; the failed tests' logs are printed at the end, not interleaved.
+# Usage: scripts/run_sanitized.sh DIR [JOBS]
+set -u
+dir=$1 jobs=${2:-2}
+cd "$(dirname "$0")/.."
+hosted=" $(grep -o 'add_rostest_gtest(test_[a-z0-9_]*' CMakeLists.txt | sed 's/.*(//' | tr '\n' ' ') "
+tests=()
+for t in "$dir"/test_*; do
+  name=$(basename "$t")
+  case "$hosted" in *" $name "*) continue ;; esac
+  [[ -f "$t" && -x "$t" ]] && tests+=("$t")
+done
+[ ${#tests[@]} -gt 0 ] || { echo "sanitize: no test binaries in $dir"; exit 1; }
+rm -f "$dir"/test_*.failed
+run_one() {
+  if ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 "$1" > "$1.log" 2>&1; then
+    echo "sanitize: $(basename "$1") clean"
+  else
+    echo "sanitize: $(basename "$1") FAILED"
+    touch "$1.failed"
+  fi
+}
+export -f run_one
+printf '%s\n' "${tests[@]}" | xargs -P "$jobs" -I{} bash -c 'run_one "$1"' _ {}
+failed=0
+for t in "${tests[@]}"; do
+  [ -e "$t.failed" ] || continue
+  failed=$((failed + 1))
+  echo "---- $(basename "$t") (last 30 lines of $t.log)"
+  tail -30 "$t.log"
+done
+echo "sanitize: $(( ${#tests[@]} - failed )) passed, $failed failed"
+[ "$failed" -eq 0 ]
