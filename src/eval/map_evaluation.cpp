@@ -75,4 +75,22 @@ MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector
   return eval;
 }
 
+Pose rigidAlign(const std::vector<cv::Vec3d>& from, const std::vector<cv::Vec3d>& to) {
+  cv::Vec3d cf(0, 0, 0), ct(0, 0, 0);
+  for (size_t i = 0; i < from.size(); ++i) {
+    cf += from[i];
+    ct += to[i];
+  }
+  cf /= static_cast<double>(from.size());
+  ct /= static_cast<double>(to.size());
+  cv::Matx33d S = cv::Matx33d::zeros();
+  for (size_t i = 0; i < from.size(); ++i) S += (to[i] - ct) * (from[i] - cf).t();
+  cv::Mat W, U, Vt;
+  cv::SVD::compute(cv::Mat(S), W, U, Vt);
+  cv::Matx33d D = cv::Matx33d::eye();
+  if (cv::determinant(cv::Mat(U * Vt)) < 0) D(2, 2) = -1;  // a rotation, not a reflection
+  const cv::Matx33d R(cv::Mat(U * cv::Mat(D) * Vt));
+  return {R, ct - R * cf};
+}
+
 }  // namespace mono_plane_detection

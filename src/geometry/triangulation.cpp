@@ -34,4 +34,11 @@ std::optional<TwoViewPoint> triangulate(const cv::Matx34d& P1, const cv::Matx34d
   return p;
 }
 
+double sampsonDistance(const cv::Matx33d& F, const cv::Point2d& x1, const cv::Point2d& x2) {
+  const cv::Vec3d a(x1.x, x1.y, 1.0), b(x2.x, x2.y, 1.0);
+  const cv::Vec3d Fa = F * a, Ftb = F.t() * b;
+  const double den = Fa[0] * Fa[0] + Fa[1] * Fa[1] + Ftb[0] * Ftb[0] + Ftb[1] * Ftb[1];
+  return den > 0 ? std::abs(b.dot(Fa)) / std::sqrt(den) : 0.0;
+}
+
 }  // namespace mono_plane_detection

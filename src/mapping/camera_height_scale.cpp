@@ -16,15 +16,6 @@ double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
   return std::acos(std::max(-1.0, std::min(1.0, unit(a).dot(unit(b))))) * 180.0 / CV_PI;
 }
 
-// Sampson distance of a correspondence to the epipolar geometry E (normalised units).
-double sampson(const cv::Matx33d& E, const cv::Point2d& a, const cv::Point2d& b) {
-  const cv::Vec3d x1 = ray(a), x2 = ray(b);
-  const cv::Vec3d Ex1 = E * x1, Etx2 = E.t() * x2;
-  const double e = x2.dot(Ex1);
-  const double den = Ex1[0] * Ex1[0] + Ex1[1] * Ex1[1] + Etx2[0] * Etx2[0] + Etx2[1] * Etx2[1];
-  return den > 0 ? std::abs(e) / std::sqrt(den) : 0;
-}
-
 // Where the plane n . x = d of the first camera carries a first-image point in the second.
 cv::Point2d transfer(const cv::Matx33d& H, const cv::Point2d& a) {
   const cv::Vec3d p = H * ray(a);
@@ -59,7 +50,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
   }
   std::vector<double> residuals;
   for (int i = 0; i < n; ++i)
-    if (mask[i]) residuals.push_back(sampson(cv::Matx33d(Em), first[i], second[i]));
+    if (mask[i]) residuals.push_back(sampsonDistance(cv::Matx33d(Em), first[i], second[i]));
   const double sigma = std::max(1.4826 * median(residuals), 0.05 / focal_px);
   const double threshold = std::min(3 * sigma, params.max_error_px / focal_px);
   out.noise_px = sigma * focal_px;
@@ -121,6 +112,11 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
   std::vector<int> candidates;
   for (int k = 0; k < m; ++k)
     if (!at_infinity[k] && nominal_down.dot(points[k]) > 0) candidates.push_back(k);
+  // How far beyond a plane a track must lie to say it is not the floor: 3 times its
+  // depth's uncertainty (depth / parallax times the noise). The same for every plane.
+  std::vector<double> beyond_tolerance(m);
+  for (int k = 0; k < m; ++k)
+    beyond_tolerance[k] = 3 * sigma / (parallax_of[k] * CV_PI / 180.0) * cv::norm(points[k]);
   const int c = static_cast<int>(candidates.size());
   for (int iteration = 0; iteration < 2000 && c >= 3; ++iteration) {
     const int i0 = candidates[rng.uniform(0, c)], i1 = candidates[rng.uniform(0, c)],
@@ -143,13 +139,9 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
         inliers.push_back(k);
         telling += !at_infinity[k];
       }
-    // The floor is the lowest surface: tracks clearly beyond it (by 3 times their
-    // depth's uncertainty, depth / parallax times the noise) say the plane is not it.
+    // The floor is the lowest surface: tracks clearly beyond it say the plane is not it.
     int beyond = 0;
-    for (int k = 0; k < m; ++k) {
-      const double depth_sigma = sigma / (parallax_of[k] * CV_PI / 180.0);
-      beyond += normal.dot(points[k]) - d > 3 * depth_sigma * cv::norm(points[k]);
-    }
+    for (int k = 0; k < m; ++k) beyond += normal.dot(points[k]) - d > beyond_tolerance[k];
     if (beyond * 5 > telling || telling < params.min_inliers) continue;
     hypotheses.push_back({d, telling, std::move(inliers)});
     best_telling = std::max(best_telling, telling);

@@ -5,6 +5,8 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/triangulation.h"
+
 namespace mono_plane_detection {
 
 std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
@@ -105,12 +107,8 @@ std::optional<cv::Matx33d> refineFundamental(const std::vector<cv::Point2d>& vie
     F = T2.t() * Fn * T1;
     F *= 1.0 / cv::norm(F);
     for (size_t i = 0; i < view1.size(); ++i) {
-      const cv::Vec3d x = homogeneous(view1[i]), y = homogeneous(view2[i]);
-      const cv::Vec3d fx = F * x, fty = F.t() * y;
-      const double den = fx[0] * fx[0] + fx[1] * fx[1] + fty[0] * fty[0] + fty[1] * fty[1];
-      const double e = y.dot(fx);
-      const double d2 = den > 0.0 ? e * e / den : 0.0;  // Sampson distance squared
-      w[i] = 1.0 / (1.0 + d2 / (scale_px * scale_px));
+      const double d = sampsonDistance(F, view1[i], view2[i]);
+      w[i] = 1.0 / (1.0 + d * d / (scale_px * scale_px));
     }
   }
   return F;

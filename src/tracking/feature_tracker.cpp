@@ -17,6 +17,16 @@ const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteri
 // The short backward pass of the forward-backward check: levels 0 and 1.
 const int kShortCheckLevel = 1;
 
+// The median image motion, per axis, of the displacements dx, dy (reordered in place:
+// the tracker's kept buffers, no copy); zero when there are none.
+cv::Point2f medianMotion(std::vector<float>& dx, std::vector<float>& dy) {
+  if (dx.empty()) return {0.f, 0.f};
+  const size_t mid = dx.size() / 2;
+  std::nth_element(dx.begin(), dx.begin() + mid, dx.end());
+  std::nth_element(dy.begin(), dy.begin() + mid, dy.end());
+  return {dx[mid], dy[mid]};
+}
+
 bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
 }
@@ -211,13 +221,7 @@ void FeatureTracker::checkBackward(const std::vector<cv::Mat>& previous_pyramid,
     motion_x_.push_back(after[i].x - before[i].x);
     motion_y_.push_back(after[i].y - before[i].y);
   }
-  cv::Point2f motion(0.f, 0.f);
-  if (!motion_x_.empty()) {
-    const size_t mid = motion_x_.size() / 2;
-    std::nth_element(motion_x_.begin(), motion_x_.begin() + mid, motion_x_.end());
-    std::nth_element(motion_y_.begin(), motion_y_.begin() + mid, motion_y_.end());
-    motion = cv::Point2f(motion_x_[mid], motion_y_[mid]);
-  }
+  const cv::Point2f motion = medianMotion(motion_x_, motion_y_);
   back_.resize(after.size());
   for (size_t i = 0; i < after.size(); ++i) back_[i] = after[i] - motion;
   const int short_level = std::min(kShortCheckLevel, std::max(0, params_.pyramid_levels - 1));
@@ -260,12 +264,7 @@ void FeatureTracker::moveLostWithImage() {
     motion_x_.push_back(d.x);
     motion_y_.push_back(d.y);
   }
-  auto middle = [](std::vector<float>& v) {  // median() of stats.h, in place (no copy)
-    const auto mid = v.begin() + v.size() / 2;
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
-  const cv::Point2f motion(middle(motion_x_), middle(motion_y_));
+  const cv::Point2f motion = medianMotion(motion_x_, motion_y_);
   for (auto& l : lost_) l.uv += motion;
 }
 

@@ -1,6 +1,8 @@
 // Judging maps against the truth: truth planes, image shares, matching.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/geometry/plane_fit.h"
 
@@ -81,4 +83,19 @@ TEST(MapEvaluation, ParallelSurfacesAreToldApartByOffset) {
   EXPECT_EQ(e.matches[0].truth_id, 1);
   EXPECT_EQ(e.matches[1].truth_id, 2);
   EXPECT_TRUE(e.split.empty());
+}
+
+// Kabsch: the rotation and translation between two copies of a point set, not a
+// reflection even when the points lie nearly in a plane.
+TEST(MapEvaluation, RigidAlignRecoversAKnownMotion) {
+  const Pose motion{cameraOrientation(0.7, 0.2, -0.1), {1.0, -2.0, 0.5}};
+  std::vector<cv::Vec3d> from, to;
+  for (int i = 0; i < 20; ++i) {
+    from.emplace_back(0.3 * i, std::sin(i), 0.01 * (i % 3));  // nearly a plane
+    to.push_back(motion.apply(from.back()));
+  }
+  const Pose found = rigidAlign(from, to);
+  EXPECT_LT(cv::norm(found.t - motion.t), 1e-9);
+  EXPECT_LT(cv::norm(cv::Mat(found.R - motion.R)), 1e-9);
+  EXPECT_NEAR(cv::determinant(cv::Mat(found.R)), 1.0, 1e-9);
 }

@@ -64,5 +64,24 @@ TEST(Triangulation, ParallelRaysGiveNothing) {
   EXPECT_FALSE(triangulate(P1, P2, {0.1, 0.2}, {0.1, 0.2}).has_value());
 }
 
+
+// Sampson distance: 0 for a pair that fits E, about the pixel offset for one moved
+// across its epipolar line.
+TEST(Triangulation, SampsonDistanceIsTheOffsetFromTheEpipolarGeometry) {
+  const cv::Matx33d R = cv::Matx33d::eye();
+  const cv::Vec3d t(1, 0, 0);  // sideways: epipolar lines are horizontal
+  const cv::Matx33d tx(0, -t[2], t[1], t[2], 0, -t[0], -t[1], t[0], 0);
+  const cv::Matx33d E = tx * R;
+  const cv::Matx34d P1 = projectionMatrix(cv::Matx33d::eye(), {0, 0, 0}), P2 = projectionMatrix(R, t);
+  const cv::Vec4d X(0.2, -0.1, 4.0, 1.0);
+  const cv::Vec3d a = P1 * X, b = P2 * X;
+  const cv::Point2d x1(a[0] / a[2], a[1] / a[2]), x2(b[0] / b[2], b[1] / b[2]);
+  EXPECT_NEAR(sampsonDistance(E, x1, x2), 0.0, 1e-12);
+  // Moved 0.01 across the (horizontal) line in the second view: the offset is shared
+  // between the two views, so the distance is 0.01 / sqrt(2).
+  EXPECT_NEAR(sampsonDistance(E, x1, x2 + cv::Point2d(0, 0.01)), 0.01 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(sampsonDistance(E, x1, x2 + cv::Point2d(0.05, 0)), 0.0, 1e-12);  // along it
+}
+
 }  // namespace
 }  // namespace mono_plane_detection

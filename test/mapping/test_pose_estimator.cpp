@@ -2,6 +2,7 @@
 // against the true trajectory.
 #include <gtest/gtest.h>
 
+#include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
 #include "support/synthetic_tracks.h"
 
@@ -153,25 +154,6 @@ std::pair<double, int> landmarkError(const PoseEstimator& e, const SyntheticTrac
   if (errors.empty()) return {1e9, 0};
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
   return {errors[errors.size() / 2], static_cast<int>(errors.size())};
-}
-
-// The rigid motion (no scale) taking `from` onto `to` (Kabsch).
-Pose rigidAlign(const std::vector<cv::Vec3d>& from, const std::vector<cv::Vec3d>& to) {
-  cv::Vec3d cf(0, 0, 0), ct(0, 0, 0);
-  for (size_t i = 0; i < from.size(); ++i) {
-    cf += from[i];
-    ct += to[i];
-  }
-  cf /= static_cast<double>(from.size());
-  ct /= static_cast<double>(to.size());
-  cv::Matx33d S = cv::Matx33d::zeros();
-  for (size_t i = 0; i < from.size(); ++i) S += (to[i] - ct) * (from[i] - cf).t();
-  cv::Mat W, U, Vt;
-  cv::SVD::compute(cv::Mat(S), W, U, Vt);
-  cv::Matx33d D = cv::Matx33d::eye();
-  if (cv::determinant(cv::Mat(U * Vt)) < 0) D(2, 2) = -1;
-  const cv::Matx33d R(cv::Mat(U * cv::Mat(D) * Vt));
-  return {R, ct - R * cf};
 }
 
 }  // namespace

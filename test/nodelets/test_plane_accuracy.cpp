@@ -28,6 +28,7 @@
 #include "../../src/sim/bag/ground_truth.h"
 #include "../../src/sim/bag/sequence_writer.h"
 #include "mono_plane_detection/PlaneArray.h"
+#include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "support/test_timeouts.h"
@@ -40,25 +41,6 @@ namespace {
 std::string g_trajectory = "wheeled";
 std::string g_metric_source = "target";
 bool g_expect_start = true;
-
-// The rigid motion (no scale) taking `from` onto `to` (Kabsch).
-Pose rigidAlign(const std::vector<cv::Vec3d>& from, const std::vector<cv::Vec3d>& to) {
-  cv::Vec3d cf(0, 0, 0), ct(0, 0, 0);
-  for (size_t i = 0; i < from.size(); ++i) {
-    cf += from[i];
-    ct += to[i];
-  }
-  cf /= static_cast<double>(from.size());
-  ct /= static_cast<double>(to.size());
-  cv::Matx33d S = cv::Matx33d::zeros();
-  for (size_t i = 0; i < from.size(); ++i) S += (to[i] - ct) * (from[i] - cf).t();
-  cv::Mat W, U, Vt;
-  cv::SVD::compute(cv::Mat(S), W, U, Vt);
-  cv::Matx33d D = cv::Matx33d::eye();
-  if (cv::determinant(cv::Mat(U * Vt)) < 0) D(2, 2) = -1;
-  const cv::Matx33d R(cv::Mat(U * cv::Mat(D) * Vt));
-  return {R, ct - R * cf};
-}
 
 TEST(PlaneAccuracy, RenderedSequence) {
   SequenceSpec spec;

@@ -50,4 +50,9 @@ MapEvaluation evaluateMap(const std::vector<MapPlane>& planes, const std::vector
                           double min_share = 0.10, double max_angle_deg = 20.0,
                           double max_offset_m = 0.3);
 
+// The rigid motion (no scale) taking the points `from` onto `to` in least squares
+// (Kabsch): compares a map with its own origin and heading (odometry, camera_height)
+// with the truth. Same sizes, at least 3 points not on a line.
+Pose rigidAlign(const std::vector<cv::Vec3d>& from, const std::vector<cv::Vec3d>& to);
+
 }  // namespace mono_plane_detection

@@ -22,4 +22,9 @@ struct TwoViewPoint {
 std::optional<TwoViewPoint> triangulate(const cv::Matx34d& P1, const cv::Matx34d& P2,
                                         const cv::Point2d& n1, const cv::Point2d& n2);
 
+// Sampson distance of the correspondence x1 <-> x2 to the epipolar geometry F (or E
+// for normalised coordinates): the first-order distance to the nearest pair that fits,
+// in the units of the points. 0 when F maps the point to no line.
+double sampsonDistance(const cv::Matx33d& F, const cv::Point2d& x1, const cv::Point2d& x2);
+
 }  // namespace mono_plane_detection

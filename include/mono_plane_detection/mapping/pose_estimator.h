@@ -133,10 +133,10 @@ class PoseEstimator {
     double stamp = 0;
     // camera_height: how many images in a row found the same floor against this view.
     int floor_count = 0;
-    cv::Vec3d floor_down;
+    cv::Vec3d floor_down{0, 0, 0};
     // The tracks' points in this view's frame (metres) by each of those images' floor.
-    std::vector<std::unordered_map<std::uint64_t, cv::Vec3d>> floor_points;
-    std::vector<cv::Vec3d> floor_downs;
+    std::vector<std::unordered_map<std::uint64_t, cv::Vec3d>> floor_points{};
+    std::vector<cv::Vec3d> floor_downs{};
   };
   FirstView firstView(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const;
 
