@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
       readToolProfile(argc, argv, MPD_CONFIG_DIR, "planes", planeNodeParamTable(), std::string("none"));
   PlaneParams params = profile.params.pipeline.planes;
   Intrinsics in1, in2;
-  std::string img1, img2, overlay = "plane_pair.png", features = "sift";
+  std::string img1, img2, overlay = "plane_pair.png", features = "sift", matches_file;
   int max_features = 4000;
   double ratio = 0.8;
   bool json = false;
@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
       .integer<unsigned>("seed", &params.groups.seed, 0, std::numeric_limits<unsigned>::max(),
                          "seed of the group choice", "S")
       .text("overlay", &overlay, "where to write the overlay image", "FILE.png")
+      .text("matches", &matches_file,
+            "also write every undistorted match as 'x1 y1 x2 y2' lines (segment_planes' input)",
+            "FILE.txt")
       .flag("json", &json, "print the planes as JSON (homography, inlier correspondences)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   if (!profile.errors.empty()) return cli.fail(profile.errors.front());
@@ -116,6 +119,16 @@ int main(int argc, char** argv) {
     }
   }
   const std::vector<cv::Point2d> ua = undistort(pa, in1), ub = undistort(pb, in2);
+  if (!matches_file.empty()) {
+    std::FILE* f = std::fopen(matches_file.c_str(), "w");
+    if (!f) return cli.fail("cannot write " + matches_file);
+    auto base = [](const std::string& path) { return path.substr(path.find_last_of('/') + 1); };
+    std::fprintf(f, "# x1 y1 x2 y2 (undistorted pixels); plane_pair %s %s\n", base(img1).c_str(),
+                 base(img2).c_str());
+    for (size_t i = 0; i < ua.size(); ++i)
+      std::fprintf(f, "%.3f %.3f %.3f %.3f\n", ua[i].x, ua[i].y, ub[i].x, ub[i].y);
+    if (std::fclose(f) != 0) return cli.fail("cannot write " + matches_file);
+  }
   const PlaneSegmentation result = segmentPlanes(ua, ub, params);
   if (!result.error.empty()) return cli.fail(result.error);
 
