@@ -64,6 +64,7 @@ report_args=(--out "$results" --frames "$frames"
   --first-message-timeout "${DEMO_FIRST_MESSAGE_TIMEOUT:-60}")
 [ -z "$truth" ] || report_args+=(--truth "$truth")
 rosrun mono_plane_detection demo_report planes:=/$camera/planes tracks:=/$camera/tracks \
+  image_planes:=/$camera/image_planes \
   image:="$image_topic" "${report_args[@]}" || status=$?
 grep -E "ERROR|FATAL" "$log" | head -5 || true
 [ $status -eq 0 ] || echo "demo: failed (exit $status); the pipeline's log: $log" >&2

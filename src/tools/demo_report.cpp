@@ -59,6 +59,7 @@ class Report {
     planes_sub_ = nh.subscribe("planes", 50, &Report::onPlanes, this);
     tracks_sub_ = nh.subscribe("tracks", 50, &Report::onTracks, this);
     image_sub_ = nh.subscribe("image", 50, &Report::onImage, this);
+    image_planes_sub_ = nh.subscribe("image_planes", 50, &Report::onImagePlanes, this);
   }
 
   // True when no message came within the first-message timeout.
@@ -84,7 +85,15 @@ class Report {
         last_planes_ ? mapPlanesOf(*last_planes_) : std::vector<MapPlane>{};
     MapEvaluation eval;
     if (truth_) eval = evaluateMap(planes, truth_->planes);
+    std::printf("image planes: %d of %d images had planes in image space\n", with_image_planes_,
+                image_plane_messages_);
     std::printf("planes in the map (confirmed): %zu\n", planes.size());
+    // An empty map without a metric start: say what starts one (docs/start_up.md).
+    if (planes.empty() && last_planes_ && !last_planes_->metric)
+      std::printf("  no metric start (%s): the map needs the start-up target in view, odometry "
+                  "(pose/metric_source odometry and odom_frame) or the camera height "
+                  "(camera_height)\n",
+                  last_planes_->status.c_str());
     YAML::Node yaml;
     for (size_t i = 0; i < planes.size(); ++i) {
       const MapPlane& p = planes[i];
@@ -160,6 +169,11 @@ class Report {
     tracker_ms_.ms.push_back(msg->processing_ms);
     tracks_[msg->header.stamp] = msg;
     while (tracks_.size() > 60) tracks_.erase(tracks_.begin());
+  }
+
+  void onImagePlanes(const PlaneArrayConstPtr& msg) {
+    ++image_plane_messages_;
+    with_image_planes_ += !msg->planes.empty();
   }
 
   void onImage(const sensor_msgs::ImageConstPtr& msg) {
@@ -272,11 +286,11 @@ class Report {
 
  private:
   std::string out_, truth_path_;
-  int expected_ = 0, planes_seen_ = 0;
+  int expected_ = 0, planes_seen_ = 0, image_plane_messages_ = 0, with_image_planes_ = 0;
   double idle_timeout_s_ = 10, first_message_timeout_s_ = 60;
   const ros::WallTime started_ = ros::WallTime::now();
   std::optional<GroundTruth> truth_;
-  ros::Subscriber planes_sub_, tracks_sub_, image_sub_;
+  ros::Subscriber planes_sub_, tracks_sub_, image_sub_, image_planes_sub_;
   ros::WallTime last_message_ = ros::WallTime::now();
   Timing tracker_ms_, planes_ms_;
   PlaneArrayConstPtr last_planes_;
@@ -294,7 +308,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "demo_report");  // takes the remappings (planes:=...) out of argv
   ReportOptions options;
   cli::Parser cli(
-      "demo_report", "[options] [planes:=TOPIC tracks:=TOPIC image:=TOPIC]",
+      "demo_report", "[options] [planes:=TOPIC tracks:=TOPIC image:=TOPIC image_planes:=TOPIC]",
       "  Listens to a running pipeline (tracks, planes, image) and, when the input ends,\n"
       "  prints what it found and writes an overlay, a top-down map and the planes as YAML.\n"
       "  With the ground truth of a generated sequence it also prints each plane's errors.",

@@ -9,8 +9,12 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
+#include <atomic>
 #include <chrono>
 #include <string>
+#include <thread>
+
+#include "mono_plane_detection/PlaneArray.h"
 
 #include "support/run_program.h"
 
@@ -93,8 +97,38 @@ TEST(DemoCli, ReportGivesUpWhenNoMessageArrives) {
   EXPECT_LT(seconds, 30);  // not a timing assertion: a hang would be 60 s (timeout)
 }
 
+// A pipeline that runs but never starts the map (a bag without the start-up target, no
+// odometry): the report says so and what would start it, and counts the image planes.
+TEST(DemoCli, ReportSaysWhyTheMapIsEmpty) {
+  ros::NodeHandle nh;
+  ros::Publisher planes = nh.advertise<PlaneArray>("/no_start/planes", 10);
+  ros::Publisher image_planes = nh.advertise<PlaneArray>("/no_start/image_planes", 10);
+  std::atomic<bool> stop{false};
+  std::thread publisher([&] {
+    PlaneArray map, image;
+    map.status = image.status = "waiting for target";
+    image.planes.resize(1);
+    while (!stop) {
+      map.header.stamp = image.header.stamp = ros::Time::now();
+      image_planes.publish(image);
+      planes.publish(map);
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  });
+  const ProgramRun r = runProgram(std::string("timeout 60 ") + DEMO_REPORT_PATH,
+                                  "planes:=/no_start/planes image_planes:=/no_start/image_planes "
+                                  "--frames 5 --out " + temp("no_start_results"));
+  stop = true;
+  publisher.join();
+  EXPECT_EQ(r.code, 1) << r.out << r.err;  // no map plane
+  EXPECT_NE(r.out.find("no metric start (waiting for target): the map needs the start-up target"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("images had planes in image space"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("image planes: 0 of"), std::string::npos) << r.out;
+}
+
 int main(int argc, char** argv) {
   testing::InitGoogleTest(&argc, argv);
-  ros::Time::init();
+  ros::init(argc, argv, "test_demo_cli");
   return RUN_ALL_TESTS();
 }
