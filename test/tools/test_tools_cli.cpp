@@ -122,6 +122,34 @@ TEST(ToolsCli, DetectTargetOnRealPhotos) {
             2);
 }
 
+// plane_pair --matches writes every undistorted match in segment_planes' input format
+// (how test/data/euroc_1403715274212143104.txt was made): two real TUM office frames, ORB
+// (SIFT needs OpenCV 4.4), the file read back by segment_planes, one label per match.
+TEST(ToolsCli, PlanePairWritesItsMatchesForSegmentPlanes) {
+  const std::string tum = std::string(TEST_DATA_DIR) + "/tum_office/";
+  const std::string matches = tempPath("plane_pair_matches.txt");
+  ProgramRun r = run(PLANE_PAIR_PATH, tum + "1341847987.758741.jpg " + tum +
+                                          "1341847989.802890.png --fx 535.4 --fy 539.2 --cx 320.1 "
+                                          "--cy 247.6 --features orb --json --overlay " +
+                                          tempPath("plane_pair.png") + " --matches " + matches);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const size_t at = r.out.find("\"matches\": ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const int count = std::stoi(r.out.substr(at + 11));
+  EXPECT_GT(count, 50);
+  r = run(SEGMENT_PLANES_PATH, matches);
+  EXPECT_EQ(r.code, 0) << r.err;
+  std::istringstream labels(r.out);
+  int lines = 0;
+  for (std::string line; std::getline(labels, line);) lines += !line.empty();
+  EXPECT_EQ(lines, count);
+  EXPECT_EQ(run(PLANE_PAIR_PATH, tum + "1341847987.758741.jpg " + tum +
+                                     "1341847989.802890.png --fx 535.4 --fy 539.2 --features orb "
+                                     "--overlay " + tempPath("plane_pair.png") +
+                                     " --matches /no/such/dir/m.txt").code,
+            2);
+}
+
 // Every tool that takes parameters reads the nodelets' profiles (--profile, profile.h);
 // an unknown profile is a usage error naming the missing file.
 TEST(ToolsCli, ToolsWithParametersRefuseAnUnknownProfile) {
