@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <unordered_set>
 
@@ -83,19 +85,25 @@ struct InducedFamily {
   cv::Vec3d e;
 };
 
-// refitPlane within the induced family: v by re-weighted least squares on the inliers,
-// then the inliers again, until they settle.
-bool refitInduced(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
-                  const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
-                  const PlaneParams& params, const InducedFamily& family) {
+// A homography fit: (view-1 points, view-2 points, weights; empty = equal) -> H or nothing.
+using HomographyFit = std::function<std::optional<cv::Matx33d>(
+    const std::vector<cv::Point2d>&, const std::vector<cv::Point2d>&, const std::vector<double>&)>;
+
+// refitPlane's rounds with a given fit (a free homography, or one of the induced family):
+// fit on the inliers (Cauchy weights at the threshold with robust_refit), the inliers
+// again, until they settle.
+bool refitWith(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
+               const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
+               const PlaneParams& params, const HomographyFit& fit) {
   for (int round = 0; round < params.refit_iterations; ++round) {
     std::vector<double> weights;
-    for (int i : inliers) {
-      const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
-      weights.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
+    if (params.robust_refit) {
+      for (int i : inliers) {
+        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
+        weights.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
+      }
     }
-    const auto fitted = fitInducedHomography(family.A, family.e, select(view1, inliers),
-                                             select(view2, inliers), weights);
+    const auto fitted = fit(select(view1, inliers), select(view2, inliers), weights);
     if (!fitted) return false;
     H = *fitted;
     std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
@@ -104,6 +112,18 @@ bool refitInduced(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<c
     inliers = std::move(next);
   }
   return true;
+}
+
+HomographyFit freeFit() {
+  return [](const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b,
+            const std::vector<double>& w) { return fitHomography(a, b, w); };
+}
+
+HomographyFit inducedFit(const InducedFamily& family) {
+  return [family](const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b,
+                  const std::vector<double>& w) {
+    return fitInducedHomography(family.A, family.e, a, b, w);
+  };
 }
 
 // Planes found one after another can be the same physical plane (split by noise):
@@ -141,26 +161,20 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
         }
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
-        // alone can stay with its own piece.
+        // alone can stay with its own piece. With `induced`, every fit is in its family.
         HomographyPlane merged;
         double together = std::numeric_limits<double>::infinity();
-        std::vector<std::optional<cv::Matx33d>> starts;
-        if (induced) {
-          starts.push_back(fitInducedHomography(induced->A, induced->e, select(view1, both),
-                                                select(view2, both)));
-        } else {
-          starts = {planes[i].H, planes[j].H, fitHomography(select(view1, both), select(view2, both))};
-        }
-        for (const std::optional<cv::Matx33d>& start : starts) {
+        const HomographyFit fit = induced ? inducedFit(*induced) : freeFit();
+        for (const std::optional<cv::Matx33d>& start :
+             {std::optional<cv::Matx33d>(planes[i].H), std::optional<cv::Matx33d>(planes[j].H),
+              fit(select(view1, both), select(view2, both), {})}) {
           if (!start) continue;
           HomographyPlane m;
           m.H = *start;
           std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
-          const bool refitted =
-              union_inliers.size() >= 4 &&
-              (induced ? refitInduced(m.H, union_inliers, view1, view2, in_union, p, *induced)
-                       : refitPlane(m.H, union_inliers, view1, view2, in_union, p));
-          if (!refitted) continue;
+          if (union_inliers.size() < 4 ||
+              !refitWith(m.H, union_inliers, view1, view2, in_union, p, fit))
+            continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
           m.threshold_px = p.vote_threshold_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
@@ -369,7 +383,13 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   cv::SVD::compute(*F, sv, u, vt);
   const cv::Vec3d e(u(0, 2), u(1, 2), u(2, 2));  // F^T e = 0
   const InducedFamily family{cv::Matx33d(0, -e[2], e[1], e[2], 0, -e[0], -e[1], e[0], 0) * *F, e};
-  for (HomographyPlane& plane : planes) {
+  auto ownNoise = [&](HomographyPlane& plane) {
+    std::vector<bool> mine(view1.size(), false);
+    for (int i : plane.inliers) mine[i] = true;
+    setPlaneNoise(plane, view1, view2, mine, energy, params);
+  };
+  for (size_t k = planes.size(); k-- > 0;) {
+    HomographyPlane& plane = planes[k];
     std::vector<double> w;
     for (int i : plane.inliers) {
       const double r = transferError(plane.H, view1[i], view2[i]) / (2.0 * plane.noise_px);
@@ -377,15 +397,19 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
     }
     const auto Hc = fitInducedHomography(family.A, family.e, select(view1, plane.inliers),
                                          select(view2, plane.inliers), w);
-    if (!Hc) continue;  // its points do not fix v: left as it is
+    if (!Hc) {  // its points do not fix a plane (collinear through the epipole): no plane
+      planes.erase(planes.begin() + static_cast<long>(k));
+      continue;
+    }
     plane.H = *Hc;
-    std::vector<bool> mine(view1.size(), false);
-    for (int i : plane.inliers) mine[i] = true;
-    setPlaneNoise(plane, view1, view2, mine, energy, params);
+    ownNoise(plane);
   }
   mergeSamePlanes(planes, view1, view2, params, energy, &family);
   std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
-  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+  for (size_t k = 0; k < planes.size(); ++k) {
+    planes[k].inliers = std::move(members[k]);
+    ownNoise(planes[k]);  // the scale reported is the one of its final points
+  }
 }
 
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
@@ -525,23 +549,7 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
 bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params) {
-  for (int round = 0; round < params.refit_iterations; ++round) {
-    std::vector<double> weights;
-    if (params.robust_refit) {
-      for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
-        weights.push_back(1.0 / (1.0 + r * r));
-      }
-    }
-    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
-    if (!fitted) return false;
-    H = *fitted;
-    std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
-    if (next.size() < 4) return false;
-    if (next == inliers) break;
-    inliers = std::move(next);
-  }
-  return true;
+  return refitWith(H, inliers, view1, view2, active, params, freeFit());
 }
 
 Thresholds fixedThresholds(const PlaneParams& params) {

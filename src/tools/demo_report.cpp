@@ -91,8 +91,8 @@ class Report {
     // An empty map without a metric start: say what starts one (docs/start_up.md).
     if (planes.empty() && last_planes_ && !last_planes_->metric)
       std::printf("  no metric start (%s): the map needs the start-up target in view, odometry "
-                  "(pose/metric_source odometry and odom_frame) or the camera height "
-                  "(camera_height)\n",
+                  "(pose/metric_source odometry with odom_frame) or the camera height "
+                  "(pose/metric_source camera_height with pose/camera_height_m)\n",
                   last_planes_->status.c_str());
     YAML::Node yaml;
     for (size_t i = 0; i < planes.size(); ++i) {

@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
                   "  image 2 uses image 1's unless --fx2 .. are given), then segmentPlanes\n"
                   "  with the core's defaults. Homographies map undistorted pixels of image 1\n"
                   "  to undistorted pixels of image 2.",
-                  "exit codes: 0 done, 2 bad usage or unreadable image\n");
+                  "exit codes: 0 done, 2 bad usage, an unreadable image or an unwritable output file\n");
   cli.positional("IMG1", &img1, "first image").positional("IMG2", &img2, "second image");
   cli.text("profile", &profile.name, profileHelp("planes"), "P");
   cli.number("fx", &in1.fx, 1e-6, 1e6, "focal length x, pixels", "PX")
@@ -122,9 +122,16 @@ int main(int argc, char** argv) {
   if (!matches_file.empty()) {
     std::FILE* f = std::fopen(matches_file.c_str(), "w");
     if (!f) return cli.fail("cannot write " + matches_file);
-    auto base = [](const std::string& path) { return path.substr(path.find_last_of('/') + 1); };
-    std::fprintf(f, "# x1 y1 x2 y2 (undistorted pixels); plane_pair %s %s\n", base(img1).c_str(),
-                 base(img2).c_str());
+    // The images' folder and name (cam0/x.png, cam1/x.png), not the whole path: the file
+    // may go into a repository.
+    auto tail = [](const std::string& path) {
+      const size_t name = path.find_last_of('/');
+      const size_t folder = name == std::string::npos || name == 0 ? std::string::npos
+                                                                    : path.find_last_of('/', name - 1);
+      return folder == std::string::npos ? path : path.substr(folder + 1);
+    };
+    std::fprintf(f, "# x1 y1 x2 y2 (undistorted pixels); plane_pair %s %s\n", tail(img1).c_str(),
+                 tail(img2).c_str());
     for (size_t i = 0; i < ua.size(); ++i)
       std::fprintf(f, "%.3f %.3f %.3f %.3f\n", ua[i].x, ua[i].y, ub[i].x, ub[i].y);
     if (std::fclose(f) != 0) return cli.fail("cannot write " + matches_file);

@@ -108,6 +108,10 @@ TEST(DemoCli, ReportSaysWhyTheMapIsEmpty) {
     PlaneArray map, image;
     map.status = image.status = "waiting for target";
     image.planes.resize(1);
+    // Both of the report's subscriptions connected before the first plane message counts
+    // towards its --frames (else a late image_planes connection would count nothing).
+    while (!stop && (planes.getNumSubscribers() == 0 || image_planes.getNumSubscribers() == 0))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     while (!stop) {
       map.header.stamp = image.header.stamp = ros::Time::now();
       image_planes.publish(image);
@@ -122,6 +126,8 @@ TEST(DemoCli, ReportSaysWhyTheMapIsEmpty) {
   publisher.join();
   EXPECT_EQ(r.code, 1) << r.out << r.err;  // no map plane
   EXPECT_NE(r.out.find("no metric start (waiting for target): the map needs the start-up target"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pose/metric_source camera_height with pose/camera_height_m"),
             std::string::npos) << r.out;
   EXPECT_NE(r.out.find("images had planes in image space"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("image planes: 0 of"), std::string::npos) << r.out;

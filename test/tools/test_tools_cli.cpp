@@ -3,6 +3,7 @@
 // without a ROS master and without waiting: the one parser of src/tools/cli_args.h.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -143,6 +144,36 @@ TEST(ToolsCli, PlanePairWritesItsMatchesForSegmentPlanes) {
   int lines = 0;
   for (std::string line; std::getline(labels, line);) lines += !line.empty();
   EXPECT_EQ(lines, count);
+  // With lens distortion the written points are undistorted: the same matches, moved
+  // (k1 -0.3 moves a point 100 px from the centre by about 1 px, at the corners by ~20).
+  const std::string distorted = tempPath("plane_pair_matches_k1.txt");
+  r = run(PLANE_PAIR_PATH, tum + "1341847987.758741.jpg " + tum +
+                               "1341847989.802890.png --fx 535.4 --fy 539.2 --cx 320.1 --cy 247.6 "
+                               "--k1 -0.3 --features orb --overlay " + tempPath("plane_pair.png") +
+                               " --matches " + distorted);
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto points = [](const std::string& path) {
+    std::ifstream in(path);
+    std::vector<std::vector<double>> rows;
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream fields(line);
+      std::vector<double> row(4);
+      for (double& v : row) fields >> v;
+      rows.push_back(row);
+    }
+    return rows;
+  };
+  const auto plain = points(matches), undistorted = points(distorted);
+  ASSERT_EQ(plain.size(), undistorted.size());
+  int moved = 0;
+  for (size_t i = 0; i < plain.size(); ++i) {
+    const double dx = undistorted[i][0] - plain[i][0], dy = undistorted[i][1] - plain[i][1];
+    // Undistortion moves a point outwards from the principal point (k1 < 0: barrel).
+    const double out = dx * (plain[i][0] - 320.1) + dy * (plain[i][1] - 247.6);
+    moved += std::hypot(dx, dy) > 0.5 && out > 0;
+  }
+  EXPECT_GT(moved, static_cast<int>(plain.size()) * 8 / 10) << moved << " of " << plain.size();
   EXPECT_EQ(run(PLANE_PAIR_PATH, tum + "1341847987.758741.jpg " + tum +
                                      "1341847989.802890.png --fx 535.4 --fy 539.2 --features orb "
                                      "--overlay " + tempPath("plane_pair.png") +
