@@ -1,15 +1,18 @@
 #include "mono_plane_detection/planes/homography_voting.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <tuple>
 #include <unordered_set>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/homography_four.h"
 #include "mono_plane_detection/planes/epipolar_check.h"
 
 namespace mono_plane_detection {
@@ -533,10 +536,28 @@ double membershipSigmas(double tail_ratio, const PlaneParams& params) {
   return lo + t * (hi - lo);
 }
 
-// Least k-th order statistic of H's transfer residuals (threshold-free fit quality).
-double kthResidual(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
-                   const std::vector<cv::Point2d>& view2, size_t kth, std::vector<double>& r) {
-  r = transferResiduals(H, view1, view2);
+// The k-th smallest of H's transfer residuals (threshold-free fit quality), or infinity
+// when it is known to be at least `bound` (at most k residuals below it), which skips the
+// selection. r: reused buffer.
+double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                        const std::vector<cv::Point2d>& view2, size_t kth, double bound,
+                        std::vector<double>& r) {
+  r.resize(view1.size());
+  size_t below = 0;
+  for (size_t i = 0; i < view1.size(); ++i) {
+    // transferResiduals' arithmetic, without its allocation.
+    const cv::Point2d& a = view1[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    double e = std::numeric_limits<double>::infinity();
+    if (std::abs(w) >= 1e-12) {
+      const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
+      const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
+      e = std::sqrt(dx * dx + dy * dy);
+    }
+    r[i] = e;
+    below += e < bound;
+  }
+  if (below <= kth) return std::numeric_limits<double>::infinity();
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
   return r[kth];
 }
@@ -570,7 +591,19 @@ struct GroupDraw {
       PointGroup key = g;
       std::sort(key.begin(), key.end());
       if (!firstTime(key)) continue;
-      d = {g, fifthPointError(g, view1_, view2_)};
+      // Groups of one four follow each other (fifth_points > 1): its homography once.
+      if (!have_four_ || !std::equal(g.begin(), g.begin() + 4, four_.begin())) {
+        cv::Point2d from[4], to[4];
+        for (int k = 0; k < 4; ++k) {
+          from[k] = view1_[g[k]];
+          to[k] = view2_[g[k]];
+          four_[k] = g[k];
+        }
+        four_h_ = homographyFromFour(from, to);
+        have_four_ = true;
+      }
+      d = {g, four_h_ ? transferError(*four_h_, view1_[g[4]], view2_[g[4]])
+                      : std::numeric_limits<double>::infinity()};
       return true;
     }
     return false;
@@ -605,6 +638,9 @@ struct GroupDraw {
   std::unordered_set<PointGroup, Hash> seen_;
   std::vector<uint64_t> packed_;
   long max_tries_ = 0;
+  std::array<int, 4> four_{};  // the last four whose homography was computed
+  std::optional<cv::Matx33d> four_h_;
+  bool have_four_ = false;
 };
 
 // The noise scale from the best first plane among the pilot's groups: those whose fifth
@@ -629,15 +665,26 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
   const size_t first = std::min(relative.size(), static_cast<size_t>(3 * params.noise_pilot_groups));
   std::partial_sort(relative.begin(), relative.begin() + static_cast<long>(first), relative.end());
   const size_t kth = std::min(view1.size() - 1, static_cast<size_t>(np.min_inliers));
+  const size_t wanted = static_cast<size_t>(std::max(0, params.noise_pilot_groups));
   std::vector<std::pair<double, cv::Matx33d>> ranked;
-  std::vector<double> r;
+  std::vector<double> r, best;  // best: the least k-th residuals so far, up to `wanted`
   for (size_t k = 0; k < first; ++k) {
     const PointGroup& g = pilot[relative[k].second].group;
     const std::vector<int> idx(g.begin(), g.end());
-    if (const auto H = fitHomography(select(view1, idx), select(view2, idx)))
-      ranked.push_back({kthResidual(*H, view1, view2, kth, r), *H});
+    const auto H = fitHomography(select(view1, idx), select(view2, idx));
+    if (!H) continue;
+    // A candidate with at most k residuals below the wanted-th least k-th residual so
+    // far cannot be among the wanted: its order statistic is not needed (same ranking).
+    const double bound = best.size() == wanted && wanted > 0 ? best.back()
+                                                             : std::numeric_limits<double>::infinity();
+    const double kth_r = kthResidualBelow(*H, view1, view2, kth, bound, r);
+    ranked.push_back({kth_r, *H});
+    if (kth_r < bound && wanted > 0) {
+      best.insert(std::upper_bound(best.begin(), best.end(), kth_r), kth_r);
+      if (best.size() > wanted) best.pop_back();
+    }
   }
-  const size_t keep = std::min(ranked.size(), static_cast<size_t>(params.noise_pilot_groups));
+  const size_t keep = std::min(ranked.size(), wanted);
   std::partial_sort(ranked.begin(), ranked.begin() + static_cast<long>(keep), ranked.end(),
                     [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<cv::Matx33d> candidates;
