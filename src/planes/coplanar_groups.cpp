@@ -165,10 +165,20 @@ bool GroupSampler::nextFifth(PointGroup& group) {
   while (next_fifth_ < end_fifth_) {
     const int f = near[static_cast<size_t>(next_fifth_++)];
     const cv::Point2d& q = points_[f];
-    // The four were tested when drawn: only the 6 triples with the fifth are left.
-    bool ok = finitePoint(q);
+    if (!finitePoint(q)) continue;
+    // The four were tested when drawn: only the 6 triples with the fifth are left
+    // (wellSpread's arithmetic; the four's edges measured once).
+    double to_q[4];
+    for (int i = 0; i < 4; ++i) to_q[i] = (*four[i] - q).dot(*four[i] - q);
+    bool ok = true;
     for (int i = 0; ok && i < 4; ++i)
-      for (int j = i + 1; ok && j < 4; ++j) ok = spreadTriple(*four[i], *four[j], q, params_.min_shape);
+      for (int j = i + 1; ok && j < 4; ++j) {
+        const cv::Point2d& a = *four[i];
+        const cv::Point2d& b = *four[j];
+        const double longest2 = std::max({four_edge2_[i][j], to_q[j], to_q[i]});
+        const double det = (b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y);
+        ok = longest2 > 0.0 && !(std::abs(det) < params_.min_shape * longest2);
+      }
     if (!ok) continue;
     group = {seeds_[four_slot_], near[0], near[1], near[2], f};
     return true;
@@ -212,6 +222,8 @@ bool GroupSampler::next(PointGroup& group) {
         for (int k = j + 1; ok && k < 4; ++k)
           ok = spreadTriple(*four[i], *four[j], *four[k], params_.min_shape);
     if (ok) {
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) four_edge2_[i][j] = (*four[i] - *four[j]).dot(*four[i] - *four[j]);
       four_slot_ = slot;
       next_fifth_ = 3;
       end_fifth_ = drawn;

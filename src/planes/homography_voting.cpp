@@ -49,10 +49,16 @@ struct Energy {
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b) const {
+    return point(p, a, b, widthCost(p));
+  }
+  // The same with the plane's width term (widthCost) computed once for many points.
+  double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
+               double width_cost) const {
     const double u = transferError(p.H, a, b) / p.noise_px;
     if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
-    return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), k2);
+    return std::min(u * u + width_cost, k2);
   }
+  double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
              const std::vector<cv::Point2d>& view2) const {
     double e = 0.0;
@@ -222,55 +228,65 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
   }
 }
 
-// Every point goes to the plane that explains it at least cost, or to none.
-std::vector<int> assignPoints(const std::vector<HomographyPlane>& planes,
-                              const std::vector<cv::Point2d>& view1,
-                              const std::vector<cv::Point2d>& view2, const Energy& energy) {
-  std::vector<int> labels(view1.size(), 0);
-  for (size_t i = 0; i < view1.size(); ++i) {
-    if (!finite(view1[i]) || !finite(view2[i])) continue;
-    double best = energy.k2;
-    for (size_t k = 0; k < planes.size(); ++k) {
-      const double e = energy.point(planes[k], view1[i], view2[i]);
-      if (e < best) {
-        best = e;
-        labels[i] = static_cast<int>(k) + 1;
-      }
-    }
-  }
-  return labels;
-}
-
 // assignPoints, then drops the plane that pays least for itself while one does not pay
 // (its points cost less than its label cost more under the other planes or as outliers)
 // or has fewer than min_plane_support points, assigning again each time. Returns each
-// plane's points.
+// plane's points. Every point goes to the plane that explains it at least cost (the
+// first on ties), or to none.
 std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& planes,
                                                   const std::vector<cv::Point2d>& view1,
                                                   const std::vector<cv::Point2d>& view2,
                                                   const PlaneParams& params, const Energy& energy) {
+  // Each point's cost under each plane once (a plane's costs do not change when another
+  // is dropped): cost[i * P + k].
+  const size_t n = view1.size();
+  std::vector<size_t> alive(planes.size());
+  std::iota(alive.begin(), alive.end(), 0);
+  std::vector<double> cost(n * planes.size(), energy.k2);
+  for (size_t k = 0; k < planes.size(); ++k) {
+    const double width = energy.widthCost(planes[k]);
+    for (size_t i = 0; i < n; ++i)
+      if (finite(view1[i]) && finite(view2[i]))
+        cost[i * planes.size() + k] = energy.point(planes[k], view1[i], view2[i], width);
+  }
+  const size_t stride = planes.size();
   for (;;) {
-    const std::vector<int> labels = assignPoints(planes, view1, view2, energy);
-    std::vector<std::vector<int>> members(planes.size());
-    std::vector<double> gain(planes.size(), -energy.plane_cost);
-    for (size_t i = 0; i < labels.size(); ++i) {
-      if (labels[i] <= 0) continue;
-      const size_t k = static_cast<size_t>(labels[i] - 1);
-      members[k].push_back(static_cast<int>(i));
-      double second = energy.k2;  // without plane k: the next best plane, or an outlier
-      for (size_t m = 0; m < planes.size(); ++m)
-        if (m != k) second = std::min(second, energy.point(planes[m], view1[i], view2[i]));
-      gain[k] += second - energy.point(planes[k], view1[i], view2[i]);
+    std::vector<std::vector<int>> members(alive.size());
+    std::vector<double> gain(alive.size(), -energy.plane_cost);
+    for (size_t i = 0; i < n; ++i) {
+      if (!finite(view1[i]) || !finite(view2[i])) continue;
+      const double* c = &cost[i * stride];
+      double best = energy.k2, second = energy.k2;
+      long label = -1;
+      for (size_t k = 0; k < alive.size(); ++k) {
+        const double e = c[alive[k]];
+        if (e < best) {
+          second = best;
+          best = e;
+          label = static_cast<long>(k);
+        } else {
+          second = std::min(second, e);
+        }
+      }
+      if (label < 0) continue;
+      members[static_cast<size_t>(label)].push_back(static_cast<int>(i));
+      // Without the plane: the next best plane, or an outlier.
+      gain[static_cast<size_t>(label)] += second - best;
     }
     long worst = -1;
-    for (size_t k = 0; k < planes.size(); ++k) {
+    for (size_t k = 0; k < alive.size(); ++k) {
       const bool fails = static_cast<int>(members[k].size()) < params.min_plane_support ||
                          gain[k] < 0.0;
       if (fails && (worst < 0 || gain[k] < gain[static_cast<size_t>(worst)]))
         worst = static_cast<long>(k);
     }
-    if (worst < 0) return members;
-    planes.erase(planes.begin() + worst);
+    if (worst < 0) {
+      std::vector<HomographyPlane> kept;
+      for (size_t k : alive) kept.push_back(std::move(planes[k]));
+      planes = std::move(kept);
+      return members;
+    }
+    alive.erase(alive.begin() + worst);
   }
 }
 
@@ -589,7 +605,8 @@ struct GroupDraw {
     while (tried < max_tries_ && sampler_.next(g)) {
       ++tried;
       PointGroup key = g;
-      std::sort(key.begin(), key.end());
+      for (size_t a = 1; a < key.size(); ++a)  // insertion sort: 5 values, std::sort's overhead
+        for (size_t b = a; b > 0 && key[b] < key[b - 1]; --b) std::swap(key[b], key[b - 1]);
       if (!firstTime(key)) continue;
       // Groups of one four follow each other (fifth_points > 1): its homography once.
       if (!have_four_ || !std::equal(g.begin(), g.begin() + 4, four_.begin())) {
@@ -648,9 +665,14 @@ struct GroupDraw {
 // homographies the noise_pilot_groups with the least k-th smallest residual (k = a tenth
 // of the points; threshold-free, robust to 90 % of the points off the plane) go to
 // estimateNoiseScale.
+// fits (out, one per pilot group): the five-point homographies fitted here, for the
+// coplanarity test to reuse (fitted[k] = 1: fits[k] holds it; 2: the fit failed).
 NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
                            const std::vector<cv::Point2d>& view1,
-                           const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
+                           const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                           std::vector<cv::Matx33d>& fits, std::vector<char>& fitted) {
+  fits.resize(pilot.size());
+  fitted.assign(pilot.size(), 0);
   NoiseScaleParams np = params.noise;
   np.min_inliers = std::max({np.min_inliers, params.min_plane_support,
                              static_cast<int>(view1.size() / 10)});
@@ -672,7 +694,9 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
     const PointGroup& g = pilot[relative[k].second].group;
     const std::vector<int> idx(g.begin(), g.end());
     const auto H = fitHomography(select(view1, idx), select(view2, idx));
+    fitted[relative[k].second] = H ? 1 : 2;
     if (!H) continue;
+    fits[relative[k].second] = *H;
     // A candidate with at most k residuals below the wanted-th least k-th residual so
     // far cannot be among the wanted: its order statistic is not needed (same ranking).
     const double bound = best.size() == wanted && wanted > 0 ? best.back()
@@ -727,8 +751,10 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   Thresholds th = fixedThresholds(user_params);
   const bool estimate = th.sigma_px <= 0.0;
   double membership_sigmas = user_params.inlier_threshold_sigma;
+  std::vector<cv::Matx33d> pilot_fits;
+  std::vector<char> pilot_fitted;  // the pilot's fits of its groups, reused by the test
   if (estimate) {
-    const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params);
+    const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params, pilot_fits, pilot_fitted);
     const double sigma = s.inliers > 0 ? s.sigma_px : user_params.noise.max_sigma_px;
     membership_sigmas = membershipSigmas(s.tail_ratio, user_params);
     th = {sigma, sigma * membership_sigmas};
@@ -753,19 +779,29 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
       std::min<long>(gp.max_groups, static_cast<long>(gp.groups_per_point) * view2.size());
   const bool transfer = gp.coplanarity_test == "transfer";
   std::vector<cv::Matx33d> candidates;
-  auto test = [&](const GroupDraw::Drawn& d) {
+  auto test = [&](const GroupDraw::Drawn& d, long pilot_index) {
     const bool ok = transfer ? d.fifth_error <= gp.transfer_threshold_sigma * th.sigma_px
                              : isCoplanarGroup(d.group, view1, view2, gp, 0.0);
     if (!ok) return;
-    const std::vector<int> idx(d.group.begin(), d.group.end());
-    if (auto H = fitHomography(select(view1, idx), select(view2, idx))) {
+    std::optional<cv::Matx33d> H;
+    const char fitted = pilot_index >= 0 && static_cast<size_t>(pilot_index) < pilot_fitted.size()
+                            ? pilot_fitted[static_cast<size_t>(pilot_index)]
+                            : 0;
+    if (fitted == 1) {
+      H = pilot_fits[static_cast<size_t>(pilot_index)];
+    } else if (fitted == 0) {
+      const std::vector<int> idx(d.group.begin(), d.group.end());
+      H = fitHomography(select(view1, idx), select(view2, idx));
+    }
+    if (H) {
       candidates.push_back(*H);
       out.accepted_groups.push_back(d.group);
     }
   };
   for (size_t i = 0; i < drawn.size() && static_cast<long>(candidates.size()) < wanted; ++i)
-    test(drawn[i]);
-  for (GroupDraw::Drawn d; static_cast<long>(candidates.size()) < wanted && draw.next(d);) test(d);
+    test(drawn[i], static_cast<long>(i));
+  for (GroupDraw::Drawn d; static_cast<long>(candidates.size()) < wanted && draw.next(d);)
+    test(d, -1);
   out.groups_built = draw.tried;
   out.groups_coplanar = static_cast<int>(out.accepted_groups.size());
 

@@ -80,6 +80,7 @@ class GroupSampler {
   // still to give: near_[four_slot_][next_fifth_ .. end_fifth_).
   size_t four_slot_ = 0;
   int next_fifth_ = 0, end_fifth_ = 0;
+  double four_edge2_[4][4] = {};  // its squared edges, [i][j] for i < j
 };
 
 // Up to `count` groups from a GroupSampler.
