@@ -112,15 +112,21 @@ NoiseScale refine(cv::Matx33d& H, NoiseScale scale, std::vector<double> r, doubl
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                   const NoiseScaleParams& params) {
   std::vector<cv::Point2d> a, b;
+  std::vector<char> in(r.size()), was;
   for (int round = 0; round < 3; ++round) {
     a.clear();
     b.clear();
     for (size_t i = 0; i < r.size(); ++i) {
-      if (r[i] <= cut) {
+      in[i] = r[i] <= cut;
+      if (in[i]) {
         a.push_back(view1[i]);
         b.push_back(view2[i]);
       }
     }
+    // The same inlier set as the last refit's: it would give the same homography and
+    // score, which does not improve on itself (converged).
+    if (in == was) break;
+    was = in;
     const auto refit = fitHomography(a, b);
     if (!refit) break;
     std::vector<double> next_r = transferResiduals(*refit, view1, view2);
