@@ -465,10 +465,11 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
       const int b1 = std::min(m, b0 + kBlock);
       int in_block = 0;
       for (int i = b0; i < b1; ++i) {
+        // |H a / w - b| < t as |H a - w b| < t |w|: no division (the vote's main cost).
         const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
-        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) / w - bx[i];
-        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) / w - by[i];
-        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2);
+        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
+        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
+        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w));
       }
       votes += in_block;
       left -= b1 - b0;
