@@ -495,11 +495,19 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
 std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                            const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                            double threshold_px) {
+  // transfersWithin without its divisions, as the vote counts (the same points on the
+  // AdelaideRMF scenes; this runs in every refit round).
   std::vector<int> inliers;
+  const double t2 = threshold_px * threshold_px;
   for (size_t i = 0; i < view1.size(); ++i) {
-    if (isActive(active, i) && transfersWithin(H, view1[i], view2[i], threshold_px)) {
+    if (!isActive(active, i)) continue;
+    const cv::Point2d& a = view1[i];
+    const cv::Point2d& b = view2[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
+    if (std::abs(w) >= 1e-12 && dx * dx + dy * dy < t2 * (w * w))
       inliers.push_back(static_cast<int>(i));
-    }
   }
   return inliers;
 }
@@ -561,6 +569,7 @@ double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& vi
                         std::vector<double>& r) {
   r.resize(view1.size());
   size_t below = 0;
+  const double bound2 = bound * bound;
   for (size_t i = 0; i < view1.size(); ++i) {
     // transferResiduals' arithmetic, without its allocation.
     const cv::Point2d& a = view1[i];
@@ -569,14 +578,14 @@ double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& vi
     if (std::abs(w) >= 1e-12) {
       const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
       const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
-      e = std::sqrt(dx * dx + dy * dy);
+      e = dx * dx + dy * dy;  // squared: the same order, one square root at the end
     }
     r[i] = e;
-    below += e < bound;
+    below += e < bound2;
   }
   if (below <= kth) return std::numeric_limits<double>::infinity();
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
-  return r[kth];
+  return std::sqrt(r[kth]);
 }
 
 // Groups drawn as findCoplanarGroups draws them (GroupSampler, repeats skipped), each with
