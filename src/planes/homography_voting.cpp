@@ -171,6 +171,8 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
                  const PlaneParams& params, const Energy& energy, double vote_px) {
   const size_t count = planes.size();
   for (size_t p = 0; p < count; ++p) {
+    // A split adds a plane: never beyond max_planes (the caller's cap, e.g. 1).
+    if (static_cast<int>(planes.size()) >= params.max_planes) return;
     const std::vector<int> members = planes[p].inliers;
     if (static_cast<int>(members.size()) < 2 * params.min_plane_support) continue;
     std::vector<bool> mine(view1.size(), false);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <string>
 #include <tuple>
 
@@ -373,4 +374,23 @@ TEST(SegmentPlanes, RealScenesBelowAMisclassificationBound) {
   PlaneParams fixed;
   fixed.vote_threshold_px = 2.0;
   EXPECT_GT(misclassificationError(s.labels, segmentPlanes(s.view1, s.view2, fixed).labels), 0.04);
+}
+
+// max_planes caps the planes found, whichever move adds them (the vote, the split move):
+// three-plane scenes give 3 planes uncapped, at most the cap otherwise.
+TEST(SegmentPlanes, MaxPlanesCapsThePlanesFound) {
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    TwoViewSceneParams sp;
+    sp.seed = seed;
+    const auto scene = makeTwoViewScene(sp);
+    PlaneParams params;
+    params.groups.seed = seed;
+    EXPECT_GE(segmentPlanes(scene.view1, scene.view2, params).planes.size(), 3u);
+    for (int cap : {1, 2}) {
+      params.max_planes = cap;
+      const PlaneSegmentation seg = segmentPlanes(scene.view1, scene.view2, params);
+      EXPECT_GE(seg.planes.size(), 1u);
+      EXPECT_LE(seg.planes.size(), static_cast<size_t>(cap)) << "seed " << seed;
+    }
+  }
 }
