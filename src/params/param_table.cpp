@@ -187,8 +187,7 @@ const ParamTable<GroupParams>& groupParamTable() {
       {"invariant_threshold", field(&P::invariant_threshold), 1e-6, 10, "",
        "cross_ratio test: five-point invariants equal within this (relative)",
        "invariant_threshold"},
-      {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable",
-       "group_seed"},
+      {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable", "group_seed"},
   };
   return table;
 }

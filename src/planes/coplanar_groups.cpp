@@ -160,8 +160,8 @@ bool finitePoint(const cv::Point2d& q) { return std::isfinite(q.x) && std::isfin
 bool GroupSampler::nextFifth(PointGroup& group) {
   if (next_fifth_ >= end_fifth_) return false;
   const std::vector<int>& near = near_[four_slot_];
-  const cv::Point2d* four[4] = {&points_[seeds_[four_slot_]], &points_[near[0]],
-                                &points_[near[1]], &points_[near[2]]};
+  const cv::Point2d* four[4] = {&points_[seeds_[four_slot_]], &points_[near[0]], &points_[near[1]],
+                                &points_[near[2]]};
   while (next_fifth_ < end_fifth_) {
     const int f = near[static_cast<size_t>(next_fifth_++)];
     const cv::Point2d& q = points_[f];
@@ -223,7 +223,8 @@ bool GroupSampler::next(PointGroup& group) {
           ok = spreadTriple(*four[i], *four[j], *four[k], params_.min_shape);
     if (ok) {
       for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) four_edge2_[i][j] = (*four[i] - *four[j]).dot(*four[i] - *four[j]);
+        for (int j = i + 1; j < 4; ++j)
+          four_edge2_[i][j] = (*four[i] - *four[j]).dot(*four[i] - *four[j]);
       four_slot_ = slot;
       next_fifth_ = 3;
       end_fifth_ = drawn;

@@ -48,10 +48,7 @@ struct Energy {
   double sigma;       // the image pair's noise scale
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
-  double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b) const {
-    return point(p, a, b, widthCost(p));
-  }
-  // The same with the plane's width term (widthCost) computed once for many points.
+  // width_cost: widthCost(p), computed once per plane (a logarithm per point otherwise).
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
     const double u = transferError(p.H, a, b) / p.noise_px;
@@ -62,7 +59,8 @@ struct Energy {
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
              const std::vector<cv::Point2d>& view2) const {
     double e = 0.0;
-    for (int i : idx) e += point(p, view1[i], view2[i]);
+    const double width = widthCost(p);
+    for (int i : idx) e += point(p, view1[i], view2[i], width);
     return e;
   }
 };
@@ -95,6 +93,8 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
     double best_gain = 0.0;
     size_t bi = 0, bj = 0;
     HomographyPlane best_plane;
+    std::vector<double> widths;  // each plane's width term, once
+    for (const HomographyPlane& plane : planes) widths.push_back(energy.widthCost(plane));
     for (size_t i = 0; i < planes.size(); ++i) {
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
@@ -111,9 +111,10 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           const int x = both[q];
           for (size_t m = 0; m < planes.size(); ++m)
             if (m != i && m != j)
-              others[q] = std::min(others[q], energy.point(planes[m], view1[x], view2[x]));
-          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x]),
-                                energy.point(planes[j], view1[x], view2[x])});
+              others[q] =
+                  std::min(others[q], energy.point(planes[m], view1[x], view2[x], widths[m]));
+          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x], widths[i]),
+                                energy.point(planes[j], view1[x], view2[x], widths[j])});
         }
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
@@ -134,8 +135,9 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           m.threshold_px = p.vote_threshold_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
+          const double width = energy.widthCost(m);
           for (size_t q = 0; q < both.size(); ++q)
-            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]]));
+            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]], width));
           if (cost < together) {
             together = cost;
             merged = m;
@@ -220,9 +222,12 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     const int b = best_candidate(rest, members.size());
     if (b < 0 || !make(b, rest, B)) continue;
     double split_cost = 2.0 * energy.plane_cost, whole_cost = energy.plane_cost;
+    const double wa = energy.widthCost(A), wb = energy.widthCost(B),
+                 ww = energy.widthCost(planes[p]);
     for (int i : members) {
-      split_cost += std::min(energy.point(A, view1[i], view2[i]), energy.point(B, view1[i], view2[i]));
-      whole_cost += energy.point(planes[p], view1[i], view2[i]);
+      split_cost += std::min(energy.point(A, view1[i], view2[i], wa),
+                             energy.point(B, view1[i], view2[i], wb));
+      whole_cost += energy.point(planes[p], view1[i], view2[i], ww);
     }
     if (split_cost >= whole_cost) continue;
     planes[p] = A;
@@ -711,8 +716,8 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
     fits[relative[k].second] = *H;
     // A candidate with at most k residuals below the wanted-th least k-th residual so
     // far cannot be among the wanted: its order statistic is not needed (same ranking).
-    const double bound = best.size() == wanted && wanted > 0 ? best.back()
-                                                             : std::numeric_limits<double>::infinity();
+    const double bound =
+        best.size() == wanted && wanted > 0 ? best.back() : std::numeric_limits<double>::infinity();
     const double kth_r = kthResidualBelow(*H, view1, view2, kth, bound, r);
     ranked.push_back({kth_r, *H});
     if (kth_r < bound && wanted > 0) {
@@ -766,7 +771,8 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   std::vector<cv::Matx33d> pilot_fits;
   std::vector<char> pilot_fitted;  // the pilot's fits of its groups, reused by the test
   if (estimate) {
-    const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params, pilot_fits, pilot_fitted);
+    const NoiseScale s =
+        pilotNoiseScale(drawn, view1, view2, user_params, pilot_fits, pilot_fitted);
     const double sigma = s.inliers > 0 ? s.sigma_px : user_params.noise.max_sigma_px;
     membership_sigmas = membershipSigmas(s.tail_ratio, user_params);
     th = {sigma, sigma * membership_sigmas};
@@ -847,7 +853,8 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
       continue;
     }
     double gain = -energy.plane_cost;
-    for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i]);
+    const double width = energy.widthCost(plane);
+    for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i], width);
     if (gain <= 0.0) break;  // the best left does not pay for itself: neither will the rest
     for (int i : plane.inliers) active[i] = false;
     planes.push_back(std::move(plane));

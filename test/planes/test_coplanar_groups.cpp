@@ -215,7 +215,8 @@ TEST(CoplanarGroups, FifthPointsShareTheirFour) {
   for (size_t i = 0; i < groups.size();) {
     size_t j = i;
     std::set<int> fifths;
-    while (j < groups.size() && std::equal(groups[i].begin(), groups[i].begin() + 4, groups[j].begin())) {
+    while (j < groups.size() &&
+           std::equal(groups[i].begin(), groups[i].begin() + 4, groups[j].begin())) {
       std::array<cv::Point2d, 5> pts;
       for (int k = 0; k < 5; ++k) pts[k] = scene.view2[groups[j][k]];
       EXPECT_TRUE(wellSpread(pts, params.min_shape));
@@ -228,8 +229,8 @@ TEST(CoplanarGroups, FifthPointsShareTheirFour) {
     ++runs;
     i = j;
   }
-  EXPECT_EQ(longest, 7u);        // the seed's other 7 neighbours (10 - 3)
-  EXPECT_LT(runs, 700u / 3);     // most fours give several groups
+  EXPECT_EQ(longest, 7u);     // the seed's other 7 neighbours (10 - 3)
+  EXPECT_LT(runs, 700u / 3);  // most fours give several groups
   EXPECT_EQ(buildGroups(scene.view2, params, 700), groups);
   params.fifth_points = 1;
   const auto single = buildGroups(scene.view2, params, 200);

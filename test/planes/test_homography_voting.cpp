@@ -9,8 +9,8 @@
 #include <tuple>
 
 #include "mono_plane_detection/eval/segmentation_error.h"
-#include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/sim/synthetic_two_view.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
