@@ -65,9 +65,11 @@ std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv
       r[i] = std::numeric_limits<double>::infinity();
       continue;
     }
-    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
-    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
-    r[i] = std::sqrt(dx * dx + dy * dy);
+    // |H a - w b| / |w|: one division instead of two (this runs ~70 times per image
+    // pair in the noise-scale estimate).
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - view2[i].x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - view2[i].y * w;
+    r[i] = std::sqrt(dx * dx + dy * dy) / std::abs(w);
   }
   return r;
 }
