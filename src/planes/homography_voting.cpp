@@ -448,7 +448,7 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
     return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
   };
   // The active points once, coordinates in separate arrays so that the count over a block
-  // of points compiles to vector instructions (the same arithmetic as transfersWithin).
+  // of points compiles to vector instructions (as inliersOf counts: no division).
   // The count of a homography stops after the block where the points left can no longer
   // make it beat the best so far (its bound is then what it could still reach).
   std::vector<double> ax, ay, bx, by;
