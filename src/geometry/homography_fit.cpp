@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace mono_plane_detection {
 namespace {
@@ -50,9 +51,41 @@ std::optional<Vector9d> smallestEigenvector(const Matrix9d& normal) {
   Vector9d d = ldlt.vectorD().cwiseAbs();
   std::sort(d.data(), d.data() + 9);
   if (!(d(1) > 1e-6 * d(8))) return eigensolverSmallest(normal);
+  // The factors once in plain arrays, each solve in unrolled loops (Eigen's LDLT solve
+  // steps: P, L^-1, D^-1 (0 for a zero pivot), L^-T, P^T): Eigen's general solve took a
+  // tenth of the plane core, 3-5 solves per fit.
+  double L[9][9], dpiv[9];
+  int perm[9];
+  const Matrix9d& f = ldlt.matrixLDLT();
+  for (int r = 0; r < 9; ++r) {
+    for (int c = 0; c < r; ++c) L[r][c] = f(r, c);
+    const double dr = ldlt.vectorD()(r);
+    dpiv[r] = std::abs(dr) > std::numeric_limits<double>::min() ? dr : 0.0;
+    perm[r] = static_cast<int>(ldlt.transpositionsP().coeff(r));
+  }
+  auto solve = [&](const Vector9d& b) {
+    double v[9];
+    for (int i = 0; i < 9; ++i) v[i] = b(i);
+    for (int k = 0; k < 9; ++k) std::swap(v[k], v[perm[k]]);
+    for (int r = 1; r < 9; ++r) {
+      double acc = v[r];
+      for (int c = 0; c < r; ++c) acc -= L[r][c] * v[c];
+      v[r] = acc;
+    }
+    for (int r = 0; r < 9; ++r) v[r] = dpiv[r] != 0.0 ? v[r] / dpiv[r] : 0.0;
+    for (int r = 7; r >= 0; --r) {
+      double acc = v[r];
+      for (int c = r + 1; c < 9; ++c) acc -= L[c][r] * v[c];
+      v[r] = acc;
+    }
+    for (int k = 8; k >= 0; --k) std::swap(v[k], v[perm[k]]);
+    Vector9d y;
+    for (int i = 0; i < 9; ++i) y(i) = v[i];
+    return y;
+  };
   Vector9d x = Vector9d::Constant(1.0 / 3.0);
   for (int it = 0; it < 20; ++it) {
-    Vector9d y = ldlt.solve(x);
+    Vector9d y = solve(x);
     const double norm = y.norm();
     if (!(norm > 0.0) || !std::isfinite(norm)) break;
     y /= norm;
@@ -79,17 +112,28 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
   // (0, -a, b_y a) and (a, 0, -b_x a) (a, b homogeneous, third coordinate 1), so A^T W A
   // is made of four 3x3 sums of w a a^T (times 1, b_x, b_y, b_x^2 + b_y^2): a fifth of
   // the work of summing the 9x9 rank-2 updates (refits run on hundreds of points).
-  Eigen::Matrix3d s0 = Eigen::Matrix3d::Zero(), sx = s0, sy = s0, sr = s0;
+  // The normalisers are similarities (scale s, shift t): a = (s x + t_x, s y + t_y, 1).
+  // w a a^T is symmetric: its 6 distinct entries (xx, xy, x, yy, y, 1) are summed, each
+  // times 1, b_x, b_y and |b|^2 (refits run on hundreds of points).
+  const double fs = (*Tf)(0, 0), ftx = (*Tf)(0, 2), fty = (*Tf)(1, 2);
+  const double ts = (*Tt)(0, 0), ttx = (*Tt)(0, 2), tty = (*Tt)(1, 2);
+  double acc[4][6] = {};
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d a = *Tf * Eigen::Vector3d(from[i].x, from[i].y, 1.0);
-    const Eigen::Vector3d b = *Tt * Eigen::Vector3d(to[i].x, to[i].y, 1.0);
+    const double ax = fs * from[i].x + ftx, ay = fs * from[i].y + fty;
+    const double bx = ts * to[i].x + ttx, by = ts * to[i].y + tty;
     const double w = weights.empty() ? 1.0 : weights[i];
-    const Eigen::Matrix3d m = (w * a) * a.transpose();
-    s0 += m;
-    sx += b.x() * m;
-    sy += b.y() * m;
-    sr += (b.x() * b.x() + b.y() * b.y()) * m;
+    const double m[6] = {w * ax * ax, w * ax * ay, w * ax, w * ay * ay, w * ay, w};
+    const double f[4] = {1.0, bx, by, bx * bx + by * by};
+    for (int k = 0; k < 4; ++k)
+      for (int e = 0; e < 6; ++e) acc[k][e] += f[k] * m[e];
   }
+  auto block = [&acc](int k) {
+    const double* q = acc[k];
+    Eigen::Matrix3d b;
+    b << q[0], q[1], q[2], q[1], q[3], q[4], q[2], q[4], q[5];
+    return b;
+  };
+  const Eigen::Matrix3d s0 = block(0), sx = block(1), sy = block(2), sr = block(3);
   Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
   normal.block<3, 3>(0, 0) = s0;
   normal.block<3, 3>(3, 3) = s0;

@@ -173,6 +173,8 @@ const ParamTable<GroupParams>& groupParamTable() {
        "seed points with a neighbour list (bounds memory)"},
       {"neighbours", field(&P::neighbours), 4, 1000, "",
        "a group is a seed and 4 of its nearest neighbours"},
+      {"fifth_points", field(&P::fifth_points), 1, 100, "",
+       "groups per four points drawn: the seed's other neighbours as the fifth point"},
       {"min_neighbour_distance_px", field(&P::min_neighbour_distance_px), 0, 100000, "px",
        "closer neighbours are passed over (invariant noise grows as the group shrinks)"},
       {"min_shape", field(&P::min_shape), 0, 1, "",
@@ -185,8 +187,7 @@ const ParamTable<GroupParams>& groupParamTable() {
       {"invariant_threshold", field(&P::invariant_threshold), 1e-6, 10, "",
        "cross_ratio test: five-point invariants equal within this (relative)",
        "invariant_threshold"},
-      {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable",
-       "group_seed"},
+      {"seed", field(&P::seed), 0, 4294967295.0, "", "random choices are repeatable", "group_seed"},
   };
   return table;
 }

@@ -143,8 +143,53 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   return near;
 }
 
+namespace {
+
+// wellSpread's test of one triple (the same arithmetic): not (nearly) collinear.
+bool spreadTriple(const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& c,
+                  double min_shape) {
+  const double longest2 = std::max({(a - b).dot(a - b), (b - c).dot(b - c), (a - c).dot(a - c)});
+  const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+  return longest2 > 0.0 && !(std::abs(det) < min_shape * longest2);
+}
+
+bool finitePoint(const cv::Point2d& q) { return std::isfinite(q.x) && std::isfinite(q.y); }
+
+}  // namespace
+
+bool GroupSampler::nextFifth(PointGroup& group) {
+  if (next_fifth_ >= end_fifth_) return false;
+  const std::vector<int>& near = near_[four_slot_];
+  const cv::Point2d* four[4] = {&points_[seeds_[four_slot_]], &points_[near[0]], &points_[near[1]],
+                                &points_[near[2]]};
+  while (next_fifth_ < end_fifth_) {
+    const int f = near[static_cast<size_t>(next_fifth_++)];
+    const cv::Point2d& q = points_[f];
+    if (!finitePoint(q)) continue;
+    // The four were tested when drawn: only the 6 triples with the fifth are left
+    // (wellSpread's arithmetic; the four's edges measured once).
+    double to_q[4];
+    for (int i = 0; i < 4; ++i) to_q[i] = (*four[i] - q).dot(*four[i] - q);
+    bool ok = true;
+    for (int i = 0; ok && i < 4; ++i)
+      for (int j = i + 1; ok && j < 4; ++j) {
+        const cv::Point2d& a = *four[i];
+        const cv::Point2d& b = *four[j];
+        const double longest2 = std::max({four_edge2_[i][j], to_q[j], to_q[i]});
+        const double det = (b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y);
+        ok = longest2 > 0.0 && !(std::abs(det) < params_.min_shape * longest2);
+      }
+    if (!ok) continue;
+    group = {seeds_[four_slot_], near[0], near[1], near[2], f};
+    return true;
+  }
+  return false;
+}
+
 bool GroupSampler::next(PointGroup& group) {
   if (seeds_.empty()) return false;
+  const bool bundle = params_.fifth_points > 1;
+  if (bundle && nextFifth(group)) return true;
   // Round-robin over the seeds; a run of degenerate draws this long means the points
   // are (nearly) all collinear, and drawing on would never end.
   const long give_up = 4L * static_cast<long>(seeds_.size()) + 64;
@@ -152,14 +197,41 @@ bool GroupSampler::next(PointGroup& group) {
     const size_t slot = static_cast<size_t>(draws_++ % static_cast<long>(seeds_.size()));
     // Shuffled in place: any order of the list is as good for the next draw.
     std::vector<int>& candidates = neighboursOf(slot);
-    for (int k = 0; k < 4; ++k) {  // partial Fisher-Yates: 4 distinct neighbours
-      std::uniform_int_distribution<int> pick_one(k, static_cast<int>(candidates.size()) - 1);
+    const int size = static_cast<int>(candidates.size());
+    // Partial Fisher-Yates: the 3 neighbours of the four and the fifth points, distinct.
+    const int drawn = bundle ? std::min(size, 3 + params_.fifth_points) : 4;
+    for (int k = 0; k < drawn; ++k) {
+      std::uniform_int_distribution<int> pick_one(k, size - 1);
       std::swap(candidates[k], candidates[pick_one(rng_)]);
     }
-    group = {seeds_[slot], candidates[0], candidates[1], candidates[2], candidates[3]};
-    if (wellSpread(pick(group, points_), params_.min_shape)) {
-      failures_in_a_row_ = 0;
-      return true;
+    if (!bundle) {
+      group = {seeds_[slot], candidates[0], candidates[1], candidates[2], candidates[3]};
+      if (wellSpread(pick(group, points_), params_.min_shape)) {
+        failures_in_a_row_ = 0;
+        return true;
+      }
+      ++failures_in_a_row_;
+      continue;
+    }
+    const cv::Point2d* four[4] = {&points_[seeds_[slot]], &points_[candidates[0]],
+                                  &points_[candidates[1]], &points_[candidates[2]]};
+    bool ok = true;
+    for (int i = 0; ok && i < 4; ++i) ok = finitePoint(*four[i]);
+    for (int i = 0; ok && i < 4; ++i)
+      for (int j = i + 1; ok && j < 4; ++j)
+        for (int k = j + 1; ok && k < 4; ++k)
+          ok = spreadTriple(*four[i], *four[j], *four[k], params_.min_shape);
+    if (ok) {
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          four_edge2_[i][j] = (*four[i] - *four[j]).dot(*four[i] - *four[j]);
+      four_slot_ = slot;
+      next_fifth_ = 3;
+      end_fifth_ = drawn;
+      if (nextFifth(group)) {
+        failures_in_a_row_ = 0;
+        return true;
+      }
     }
     ++failures_in_a_row_;
   }

@@ -1,6 +1,7 @@
 #include "mono_plane_detection/planes/homography_voting.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -12,6 +13,7 @@
 #include <unordered_set>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/homography_four.h"
 #include "mono_plane_detection/planes/epipolar_check.h"
 
 namespace mono_plane_detection {
@@ -47,15 +49,19 @@ struct Energy {
   double sigma;       // the image pair's noise scale
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
-  double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b) const {
+  // width_cost: widthCost(p), computed once per plane (a logarithm per point otherwise).
+  double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
+               double width_cost) const {
     const double u = transferError(p.H, a, b) / p.noise_px;
     if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
-    return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), k2);
+    return std::min(u * u + width_cost, k2);
   }
+  double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
              const std::vector<cv::Point2d>& view2) const {
     double e = 0.0;
-    for (int i : idx) e += point(p, view1[i], view2[i]);
+    const double width = widthCost(p);
+    for (int i : idx) e += point(p, view1[i], view2[i], width);
     return e;
   }
 };
@@ -139,6 +145,8 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
     double best_gain = 0.0;
     size_t bi = 0, bj = 0;
     HomographyPlane best_plane;
+    std::vector<double> widths;  // each plane's width term, once
+    for (const HomographyPlane& plane : planes) widths.push_back(energy.widthCost(plane));
     for (size_t i = 0; i < planes.size(); ++i) {
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
@@ -155,9 +163,10 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           const int x = both[q];
           for (size_t m = 0; m < planes.size(); ++m)
             if (m != i && m != j)
-              others[q] = std::min(others[q], energy.point(planes[m], view1[x], view2[x]));
-          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x]),
-                                energy.point(planes[j], view1[x], view2[x])});
+              others[q] =
+                  std::min(others[q], energy.point(planes[m], view1[x], view2[x], widths[m]));
+          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x], widths[i]),
+                                energy.point(planes[j], view1[x], view2[x], widths[j])});
         }
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
@@ -179,8 +188,9 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           m.threshold_px = p.vote_threshold_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
+          const double width = energy.widthCost(m);
           for (size_t q = 0; q < both.size(); ++q)
-            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]]));
+            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]], width));
           if (cost < together) {
             together = cost;
             merged = m;
@@ -216,6 +226,8 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
                  const PlaneParams& params, const Energy& energy, double vote_px) {
   const size_t count = planes.size();
   for (size_t p = 0; p < count; ++p) {
+    // A split adds a plane: never beyond max_planes (the caller's cap, e.g. 1).
+    if (static_cast<int>(planes.size()) >= params.max_planes) return;
     const std::vector<int> members = planes[p].inliers;
     if (static_cast<int>(members.size()) < 2 * params.min_plane_support) continue;
     std::vector<bool> mine(view1.size(), false);
@@ -263,9 +275,12 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     const int b = best_candidate(rest, members.size());
     if (b < 0 || !make(b, rest, B)) continue;
     double split_cost = 2.0 * energy.plane_cost, whole_cost = energy.plane_cost;
+    const double wa = energy.widthCost(A), wb = energy.widthCost(B),
+                 ww = energy.widthCost(planes[p]);
     for (int i : members) {
-      split_cost += std::min(energy.point(A, view1[i], view2[i]), energy.point(B, view1[i], view2[i]));
-      whole_cost += energy.point(planes[p], view1[i], view2[i]);
+      split_cost += std::min(energy.point(A, view1[i], view2[i], wa),
+                             energy.point(B, view1[i], view2[i], wb));
+      whole_cost += energy.point(planes[p], view1[i], view2[i], ww);
     }
     if (split_cost >= whole_cost) continue;
     planes[p] = A;
@@ -273,55 +288,65 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
   }
 }
 
-// Every point goes to the plane that explains it at least cost, or to none.
-std::vector<int> assignPoints(const std::vector<HomographyPlane>& planes,
-                              const std::vector<cv::Point2d>& view1,
-                              const std::vector<cv::Point2d>& view2, const Energy& energy) {
-  std::vector<int> labels(view1.size(), 0);
-  for (size_t i = 0; i < view1.size(); ++i) {
-    if (!finite(view1[i]) || !finite(view2[i])) continue;
-    double best = energy.k2;
-    for (size_t k = 0; k < planes.size(); ++k) {
-      const double e = energy.point(planes[k], view1[i], view2[i]);
-      if (e < best) {
-        best = e;
-        labels[i] = static_cast<int>(k) + 1;
-      }
-    }
-  }
-  return labels;
-}
-
 // assignPoints, then drops the plane that pays least for itself while one does not pay
 // (its points cost less than its label cost more under the other planes or as outliers)
 // or has fewer than min_plane_support points, assigning again each time. Returns each
-// plane's points.
+// plane's points. Every point goes to the plane that explains it at least cost (the
+// first on ties), or to none.
 std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& planes,
                                                   const std::vector<cv::Point2d>& view1,
                                                   const std::vector<cv::Point2d>& view2,
                                                   const PlaneParams& params, const Energy& energy) {
+  // Each point's cost under each plane once (a plane's costs do not change when another
+  // is dropped): cost[i * P + k].
+  const size_t n = view1.size();
+  std::vector<size_t> alive(planes.size());
+  std::iota(alive.begin(), alive.end(), 0);
+  std::vector<double> cost(n * planes.size(), energy.k2);
+  for (size_t k = 0; k < planes.size(); ++k) {
+    const double width = energy.widthCost(planes[k]);
+    for (size_t i = 0; i < n; ++i)
+      if (finite(view1[i]) && finite(view2[i]))
+        cost[i * planes.size() + k] = energy.point(planes[k], view1[i], view2[i], width);
+  }
+  const size_t stride = planes.size();
   for (;;) {
-    const std::vector<int> labels = assignPoints(planes, view1, view2, energy);
-    std::vector<std::vector<int>> members(planes.size());
-    std::vector<double> gain(planes.size(), -energy.plane_cost);
-    for (size_t i = 0; i < labels.size(); ++i) {
-      if (labels[i] <= 0) continue;
-      const size_t k = static_cast<size_t>(labels[i] - 1);
-      members[k].push_back(static_cast<int>(i));
-      double second = energy.k2;  // without plane k: the next best plane, or an outlier
-      for (size_t m = 0; m < planes.size(); ++m)
-        if (m != k) second = std::min(second, energy.point(planes[m], view1[i], view2[i]));
-      gain[k] += second - energy.point(planes[k], view1[i], view2[i]);
+    std::vector<std::vector<int>> members(alive.size());
+    std::vector<double> gain(alive.size(), -energy.plane_cost);
+    for (size_t i = 0; i < n; ++i) {
+      if (!finite(view1[i]) || !finite(view2[i])) continue;
+      const double* c = &cost[i * stride];
+      double best = energy.k2, second = energy.k2;
+      long label = -1;
+      for (size_t k = 0; k < alive.size(); ++k) {
+        const double e = c[alive[k]];
+        if (e < best) {
+          second = best;
+          best = e;
+          label = static_cast<long>(k);
+        } else {
+          second = std::min(second, e);
+        }
+      }
+      if (label < 0) continue;
+      members[static_cast<size_t>(label)].push_back(static_cast<int>(i));
+      // Without the plane: the next best plane, or an outlier.
+      gain[static_cast<size_t>(label)] += second - best;
     }
     long worst = -1;
-    for (size_t k = 0; k < planes.size(); ++k) {
+    for (size_t k = 0; k < alive.size(); ++k) {
       const bool fails = static_cast<int>(members[k].size()) < params.min_plane_support ||
                          gain[k] < 0.0;
       if (fails && (worst < 0 || gain[k] < gain[static_cast<size_t>(worst)]))
         worst = static_cast<long>(k);
     }
-    if (worst < 0) return members;
-    planes.erase(planes.begin() + worst);
+    if (worst < 0) {
+      std::vector<HomographyPlane> kept;
+      for (size_t k : alive) kept.push_back(std::move(planes[k]));
+      planes = std::move(kept);
+      return members;
+    }
+    alive.erase(alive.begin() + worst);
   }
 }
 
@@ -484,7 +509,7 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
     return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
   };
   // The active points once, coordinates in separate arrays so that the count over a block
-  // of points compiles to vector instructions (the same arithmetic as transfersWithin).
+  // of points compiles to vector instructions (as inliersOf counts: no division).
   // The count of a homography stops after the block where the points left can no longer
   // make it beat the best so far (its bound is then what it could still reach).
   std::vector<double> ax, ay, bx, by;
@@ -508,10 +533,11 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
       const int b1 = std::min(m, b0 + kBlock);
       int in_block = 0;
       for (int i = b0; i < b1; ++i) {
+        // |H a / w - b| < t as |H a - w b| < t |w|: no division (the vote's main cost).
         const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
-        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) / w - bx[i];
-        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) / w - by[i];
-        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2);
+        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
+        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
+        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w));
       }
       votes += in_block;
       left -= b1 - b0;
@@ -537,11 +563,19 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
 std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                            const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                            double threshold_px) {
+  // transfersWithin without its divisions, as the vote counts (the same points on the
+  // AdelaideRMF scenes; this runs in every refit round).
   std::vector<int> inliers;
+  const double t2 = threshold_px * threshold_px;
   for (size_t i = 0; i < view1.size(); ++i) {
-    if (isActive(active, i) && transfersWithin(H, view1[i], view2[i], threshold_px)) {
+    if (!isActive(active, i)) continue;
+    const cv::Point2d& a = view1[i];
+    const cv::Point2d& b = view2[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
+    if (std::abs(w) >= 1e-12 && dx * dx + dy * dy < t2 * (w * w))
       inliers.push_back(static_cast<int>(i));
-    }
   }
   return inliers;
 }
@@ -579,12 +613,31 @@ double membershipSigmas(double tail_ratio, const PlaneParams& params) {
   return lo + t * (hi - lo);
 }
 
-// Least k-th order statistic of H's transfer residuals (threshold-free fit quality).
-double kthResidual(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
-                   const std::vector<cv::Point2d>& view2, size_t kth, std::vector<double>& r) {
-  r = transferResiduals(H, view1, view2);
+// The k-th smallest of H's transfer residuals (threshold-free fit quality), or infinity
+// when it is known to be at least `bound` (at most k residuals below it), which skips the
+// selection. r: reused buffer.
+double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                        const std::vector<cv::Point2d>& view2, size_t kth, double bound,
+                        std::vector<double>& r) {
+  r.resize(view1.size());
+  size_t below = 0;
+  const double bound2 = bound * bound;
+  for (size_t i = 0; i < view1.size(); ++i) {
+    // transferResiduals' arithmetic, without its allocation.
+    const cv::Point2d& a = view1[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    double e = std::numeric_limits<double>::infinity();
+    if (std::abs(w) >= 1e-12) {
+      const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
+      const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
+      e = dx * dx + dy * dy;  // squared: the same order, one square root at the end
+    }
+    r[i] = e;
+    below += e < bound2;
+  }
+  if (below <= kth) return std::numeric_limits<double>::infinity();
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
-  return r[kth];
+  return std::sqrt(r[kth]);
 }
 
 // Groups drawn as findCoplanarGroups draws them (GroupSampler, repeats skipped), each with
@@ -614,9 +667,22 @@ struct GroupDraw {
     while (tried < max_tries_ && sampler_.next(g)) {
       ++tried;
       PointGroup key = g;
-      std::sort(key.begin(), key.end());
+      for (size_t a = 1; a < key.size(); ++a)  // insertion sort: 5 values, std::sort's overhead
+        for (size_t b = a; b > 0 && key[b] < key[b - 1]; --b) std::swap(key[b], key[b - 1]);
       if (!firstTime(key)) continue;
-      d = {g, fifthPointError(g, view1_, view2_)};
+      // Groups of one four follow each other (fifth_points > 1): its homography once.
+      if (!have_four_ || !std::equal(g.begin(), g.begin() + 4, four_.begin())) {
+        cv::Point2d from[4], to[4];
+        for (int k = 0; k < 4; ++k) {
+          from[k] = view1_[g[k]];
+          to[k] = view2_[g[k]];
+          four_[k] = g[k];
+        }
+        four_h_ = homographyFromFour(from, to);
+        have_four_ = true;
+      }
+      d = {g, four_h_ ? transferError(*four_h_, view1_[g[4]], view2_[g[4]])
+                      : std::numeric_limits<double>::infinity()};
       return true;
     }
     return false;
@@ -651,6 +717,9 @@ struct GroupDraw {
   std::unordered_set<PointGroup, Hash> seen_;
   std::vector<uint64_t> packed_;
   long max_tries_ = 0;
+  std::array<int, 4> four_{};  // the last four whose homography was computed
+  std::optional<cv::Matx33d> four_h_;
+  bool have_four_ = false;
 };
 
 // The noise scale from the best first plane among the pilot's groups: those whose fifth
@@ -658,9 +727,14 @@ struct GroupDraw {
 // homographies the noise_pilot_groups with the least k-th smallest residual (k = a tenth
 // of the points; threshold-free, robust to 90 % of the points off the plane) go to
 // estimateNoiseScale.
+// fits (out, one per pilot group): the five-point homographies fitted here, for the
+// coplanarity test to reuse (fitted[k] = 1: fits[k] holds it; 2: the fit failed).
 NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
                            const std::vector<cv::Point2d>& view1,
-                           const std::vector<cv::Point2d>& view2, const PlaneParams& params) {
+                           const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                           std::vector<cv::Matx33d>& fits, std::vector<char>& fitted) {
+  fits.resize(pilot.size());
+  fitted.assign(pilot.size(), 0);
   NoiseScaleParams np = params.noise;
   np.min_inliers = std::max({np.min_inliers, params.min_plane_support,
                              static_cast<int>(view1.size() / 10)});
@@ -675,15 +749,28 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
   const size_t first = std::min(relative.size(), static_cast<size_t>(3 * params.noise_pilot_groups));
   std::partial_sort(relative.begin(), relative.begin() + static_cast<long>(first), relative.end());
   const size_t kth = std::min(view1.size() - 1, static_cast<size_t>(np.min_inliers));
+  const size_t wanted = static_cast<size_t>(std::max(0, params.noise_pilot_groups));
   std::vector<std::pair<double, cv::Matx33d>> ranked;
-  std::vector<double> r;
+  std::vector<double> r, best;  // best: the least k-th residuals so far, up to `wanted`
   for (size_t k = 0; k < first; ++k) {
     const PointGroup& g = pilot[relative[k].second].group;
     const std::vector<int> idx(g.begin(), g.end());
-    if (const auto H = fitHomography(select(view1, idx), select(view2, idx)))
-      ranked.push_back({kthResidual(*H, view1, view2, kth, r), *H});
+    const auto H = fitHomography(select(view1, idx), select(view2, idx));
+    fitted[relative[k].second] = H ? 1 : 2;
+    if (!H) continue;
+    fits[relative[k].second] = *H;
+    // A candidate with at most k residuals below the wanted-th least k-th residual so
+    // far cannot be among the wanted: its order statistic is not needed (same ranking).
+    const double bound =
+        best.size() == wanted && wanted > 0 ? best.back() : std::numeric_limits<double>::infinity();
+    const double kth_r = kthResidualBelow(*H, view1, view2, kth, bound, r);
+    ranked.push_back({kth_r, *H});
+    if (kth_r < bound && wanted > 0) {
+      best.insert(std::upper_bound(best.begin(), best.end(), kth_r), kth_r);
+      if (best.size() > wanted) best.pop_back();
+    }
   }
-  const size_t keep = std::min(ranked.size(), static_cast<size_t>(params.noise_pilot_groups));
+  const size_t keep = std::min(ranked.size(), wanted);
   std::partial_sort(ranked.begin(), ranked.begin() + static_cast<long>(keep), ranked.end(),
                     [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<cv::Matx33d> candidates;
@@ -726,8 +813,11 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   Thresholds th = fixedThresholds(user_params);
   const bool estimate = th.sigma_px <= 0.0;
   double membership_sigmas = user_params.inlier_threshold_sigma;
+  std::vector<cv::Matx33d> pilot_fits;
+  std::vector<char> pilot_fitted;  // the pilot's fits of its groups, reused by the test
   if (estimate) {
-    const NoiseScale s = pilotNoiseScale(drawn, view1, view2, user_params);
+    const NoiseScale s =
+        pilotNoiseScale(drawn, view1, view2, user_params, pilot_fits, pilot_fitted);
     const double sigma = s.inliers > 0 ? s.sigma_px : user_params.noise.max_sigma_px;
     membership_sigmas = membershipSigmas(s.tail_ratio, user_params);
     th = {sigma, sigma * membership_sigmas};
@@ -752,19 +842,29 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
       std::min<long>(gp.max_groups, static_cast<long>(gp.groups_per_point) * view2.size());
   const bool transfer = gp.coplanarity_test == "transfer";
   std::vector<cv::Matx33d> candidates;
-  auto test = [&](const GroupDraw::Drawn& d) {
+  auto test = [&](const GroupDraw::Drawn& d, long pilot_index) {
     const bool ok = transfer ? d.fifth_error <= gp.transfer_threshold_sigma * th.sigma_px
                              : isCoplanarGroup(d.group, view1, view2, gp, 0.0);
     if (!ok) return;
-    const std::vector<int> idx(d.group.begin(), d.group.end());
-    if (auto H = fitHomography(select(view1, idx), select(view2, idx))) {
+    std::optional<cv::Matx33d> H;
+    const char fitted = pilot_index >= 0 && static_cast<size_t>(pilot_index) < pilot_fitted.size()
+                            ? pilot_fitted[static_cast<size_t>(pilot_index)]
+                            : 0;
+    if (fitted == 1) {
+      H = pilot_fits[static_cast<size_t>(pilot_index)];
+    } else if (fitted == 0) {
+      const std::vector<int> idx(d.group.begin(), d.group.end());
+      H = fitHomography(select(view1, idx), select(view2, idx));
+    }
+    if (H) {
       candidates.push_back(*H);
       out.accepted_groups.push_back(d.group);
     }
   };
   for (size_t i = 0; i < drawn.size() && static_cast<long>(candidates.size()) < wanted; ++i)
-    test(drawn[i]);
-  for (GroupDraw::Drawn d; static_cast<long>(candidates.size()) < wanted && draw.next(d);) test(d);
+    test(drawn[i], static_cast<long>(i));
+  for (GroupDraw::Drawn d; static_cast<long>(candidates.size()) < wanted && draw.next(d);)
+    test(d, -1);
   out.groups_built = draw.tried;
   out.groups_coplanar = static_cast<int>(out.accepted_groups.size());
 
@@ -798,7 +898,8 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
       continue;
     }
     double gain = -energy.plane_cost;
-    for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i]);
+    const double width = energy.widthCost(plane);
+    for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i], width);
     if (gain <= 0.0) break;  // the best left does not pay for itself: neither will the rest
     for (int i : plane.inliers) active[i] = false;
     planes.push_back(std::move(plane));

@@ -65,9 +65,11 @@ std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv
       r[i] = std::numeric_limits<double>::infinity();
       continue;
     }
-    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
-    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
-    r[i] = std::sqrt(dx * dx + dy * dy);
+    // |H a - w b| / |w|: one division instead of two (this runs ~70 times per image
+    // pair in the noise-scale estimate).
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - view2[i].x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - view2[i].y * w;
+    r[i] = std::sqrt(dx * dx + dy * dy) / std::abs(w);
   }
   return r;
 }
@@ -112,15 +114,21 @@ NoiseScale refine(cv::Matx33d& H, NoiseScale scale, std::vector<double> r, doubl
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
                   const NoiseScaleParams& params) {
   std::vector<cv::Point2d> a, b;
+  std::vector<char> in(r.size()), was;
   for (int round = 0; round < 3; ++round) {
     a.clear();
     b.clear();
     for (size_t i = 0; i < r.size(); ++i) {
-      if (r[i] <= cut) {
+      in[i] = r[i] <= cut;
+      if (in[i]) {
         a.push_back(view1[i]);
         b.push_back(view2[i]);
       }
     }
+    // The same inlier set as the last refit's: it would give the same homography and
+    // score, which does not improve on itself (converged).
+    if (in == was) break;
+    was = in;
     const auto refit = fitHomography(a, b);
     if (!refit) break;
     std::vector<double> next_r = transferResiduals(*refit, view1, view2);

@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
                "core: coplanar groups kept per image pair")
       .integer("tries-per-point", &params.groups.tries_per_point, 1, 100000,
                "core: groups tried per point at most")
+      .integer("fifth-points", &params.groups.fifth_points, 1, 100,
+               "core: groups per four points drawn (the seed's other neighbours as fifth)")
       .integer("pilot-groups", &params.noise_pilot_groups, 1, 1000,
                "core: candidate first planes the noise scale is taken from")
       .integer("min-tries", &params.groups.min_tries, 1, 100000,

@@ -200,3 +200,42 @@ TEST(CoplanarGroups, NeighbourListsAreTheNearestOfTheDistanceRow) {
     }
   }
 }
+
+TEST(CoplanarGroups, FifthPointsShareTheirFour) {
+  // fifth_points > 1: runs of groups with the same seed and 3 neighbours, each completed
+  // by a different other neighbour, every group still well spread; 1: one group per four.
+  TwoViewSceneParams sp;
+  sp.outlier_fraction = 0;
+  const auto scene = makeTwoViewScene(sp);
+  GroupParams params;
+  params.fifth_points = 7;
+  const auto groups = buildGroups(scene.view2, params, 700);
+  ASSERT_EQ(groups.size(), 700u);
+  size_t runs = 0, longest = 0;
+  for (size_t i = 0; i < groups.size();) {
+    size_t j = i;
+    std::set<int> fifths;
+    while (j < groups.size() &&
+           std::equal(groups[i].begin(), groups[i].begin() + 4, groups[j].begin())) {
+      std::array<cv::Point2d, 5> pts;
+      for (int k = 0; k < 5; ++k) pts[k] = scene.view2[groups[j][k]];
+      EXPECT_TRUE(wellSpread(pts, params.min_shape));
+      EXPECT_EQ(std::set<int>(groups[j].begin(), groups[j].end()).size(), 5u);
+      EXPECT_TRUE(fifths.insert(groups[j][4]).second) << "a fifth point twice for one four";
+      ++j;
+    }
+    EXPECT_LE(j - i, static_cast<size_t>(params.fifth_points));
+    longest = std::max(longest, j - i);
+    ++runs;
+    i = j;
+  }
+  EXPECT_EQ(longest, 7u);     // the seed's other 7 neighbours (10 - 3)
+  EXPECT_LT(runs, 700u / 3);  // most fours give several groups
+  EXPECT_EQ(buildGroups(scene.view2, params, 700), groups);
+  params.fifth_points = 1;
+  const auto single = buildGroups(scene.view2, params, 200);
+  size_t shared = 0;
+  for (size_t i = 1; i < single.size(); ++i)
+    shared += std::equal(single[i].begin(), single[i].begin() + 4, single[i - 1].begin());
+  EXPECT_EQ(shared, 0u);
+}
