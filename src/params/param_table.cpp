@@ -236,7 +236,7 @@ const ParamTable<PlaneParams>& planeParamTable() {
         {"noise_pilot_groups", field(&P::noise_pilot_groups), 1, 10000, "",
          "candidate first planes the noise scale is estimated from"},
         {"epipolar_check", field(&P::epipolar_check), 0, 1, "",
-         "F from the planes' points: drop planes off it, keep only homographies it induces"},
+         "F from the planes' points: drop planes off it, use its homographies when cheaper"},
     };
     appendNested(t, "groups/", &P::groups, groupParamTable());
     appendNested(t, "noise/", &P::noise, noiseScaleParamTable());

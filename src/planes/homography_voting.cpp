@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -84,71 +83,12 @@ void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1
                            : params.inlier_threshold_sigma * plane.noise_px;
 }
 
-// The homographies the epipolar geometry admits: H = A + e v^T, A = [e]x F, e the epipole
-// of view 2 (planes/epipolar_check.h).
-struct InducedFamily {
-  cv::Matx33d A;
-  cv::Vec3d e;
-};
-
-// A homography fit: (view-1 points, view-2 points, weights; empty = equal) -> H or nothing.
-using HomographyFit = std::function<std::optional<cv::Matx33d>(
-    const std::vector<cv::Point2d>&, const std::vector<cv::Point2d>&, const std::vector<double>&)>;
-
-// refitPlane's rounds with a given fit (a free homography, or one of the induced family):
-// fit on the inliers (Cauchy weights at the threshold with robust_refit), the inliers
-// again, until they settle.
-bool refitWith(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
-               const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
-               const PlaneParams& params, const HomographyFit& fit) {
-  for (int round = 0; round < params.refit_iterations; ++round) {
-    std::vector<double> weights;
-    if (params.robust_refit) {
-      for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
-        weights.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
-      }
-    }
-    const auto fitted = fit(select(view1, inliers), select(view2, inliers), weights);
-    if (!fitted) return false;
-    H = *fitted;
-    std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
-    if (next.size() < 4) return false;
-    if (next == inliers) break;
-    inliers = std::move(next);
-  }
-  return true;
-}
-
-HomographyFit freeFit() {
-  return [](const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b,
-            const std::vector<double>& w) { return fitHomography(a, b, w); };
-}
-
-HomographyFit inducedFit(const InducedFamily& family) {
-  return [family](const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b,
-                  const std::vector<double>& w) {
-    return fitInducedHomography(family.A, family.e, a, b, w);
-  };
-}
-
-// True when a's homography transfers at least half of b's points within a's threshold.
-bool carriesMost(const HomographyPlane& a, const HomographyPlane& b,
-                 const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2) {
-  size_t within = 0;
-  for (int i : b.inliers) within += transfersWithin(a.H, view1[i], view2[i], a.threshold_px);
-  return 2 * within >= b.inliers.size() && !b.inliers.empty();
-}
-
 // Planes found one after another can be the same physical plane (split by noise):
 // two are merged when the criterion says so: one homography refitted on both costs less
 // than the two, one plane's label cost included. Best merge first, until none pays.
-// With `induced`, the merged plane is the best plane-induced homography on the union (3
-// parameters: it extrapolates where a free one, fitted on one patch, does not: a strip of
-// floor tape far from the rest of the floor on EuRoC).
 void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                      const std::vector<cv::Point2d>& view2, const PlaneParams& params,
-                     const Energy& energy, const InducedFamily* induced = nullptr) {
+                     const Energy& energy) {
   for (;;) {
     double best_gain = 0.0;
     size_t bi = 0, bj = 0;
@@ -157,12 +97,6 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
     for (const HomographyPlane& plane : planes) widths.push_back(energy.widthCost(plane));
     for (size_t i = 0; i < planes.size(); ++i) {
       for (size_t j = i + 1; j < planes.size(); ++j) {
-        // Induced: pieces of one plane have nearly the same induced homography, so one of
-        // them carries most of the other's points within its threshold; a pair where
-        // neither does is not refitted (most pairs: the merge's cost at 500-1000 points).
-        if (induced && !carriesMost(planes[i], planes[j], view1, view2) &&
-            !carriesMost(planes[j], planes[i], view1, view2))
-          continue;
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
         std::vector<bool> in_union(view1.size(), false);
@@ -184,19 +118,18 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
         }
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
-        // alone can stay with its own piece. With `induced`, every fit is in its family.
+        // alone can stay with its own piece.
         HomographyPlane merged;
         double together = std::numeric_limits<double>::infinity();
-        const HomographyFit fit = induced ? inducedFit(*induced) : freeFit();
+        const auto union_fit = fitHomography(select(view1, both), select(view2, both));
         for (const std::optional<cv::Matx33d>& start :
              {std::optional<cv::Matx33d>(planes[i].H), std::optional<cv::Matx33d>(planes[j].H),
-              fit(select(view1, both), select(view2, both), {})}) {
+              union_fit}) {
           if (!start) continue;
           HomographyPlane m;
           m.H = *start;
           std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
-          if (union_inliers.size() < 4 ||
-              !refitWith(m.H, union_inliers, view1, view2, in_union, p, fit))
+          if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
             continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
           m.threshold_px = p.vote_threshold_px;
@@ -396,18 +329,13 @@ void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
   for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
 }
 
-// Only plane-induced homographies: once F is determined, each plane's homography is
-// replaced by the best one F admits on its points ([e2]x F + e2 v^T, 3 parameters; F
-// refined by least squares on RANSAC's inliers), with its own noise scale. A free
-// homography (8 parameters) on a few or nearly collinear points (a strip of floor tape on
-// EuRoC) fits them but is induced by no plane: its normal is wrong by 10-20 deg. Not
-// kept: the induced one only when it costs no more than the 5 parameters it saves (at the
-// label cost's price per parameter): better on AdelaideRMF (2.83 against 3.10 % over 20
-// seeds) but the tape strip's free fit won (127 against a price of 90: a lens model's
-// residual at the image edge fits a free homography's extra parameters) and it stayed a
-// plane of its own (docs/plane_core.md). Then pieces of one plane merge when one induced
-// homography pays for both, points are assigned again (no free refit, which would undo
-// it), and a plane that no longer pays is dropped.
+// Model selection between each plane's own homography (8 parameters) and the best one F
+// admits on its points ([e2]x F + e2 v^T, 3 parameters; F refined by least squares on
+// RANSAC's inliers): the induced one is taken when it costs no more than the 5 parameters
+// it saves, at the label cost's price per parameter (plane_penalty / 8 x ln N). A plane
+// on few or nearly collinear points (a strip of tape) has a free homography that fits
+// them but is induced by no plane. Points are then assigned again (no refit, which would
+// undo it), and a plane that no longer pays is dropped.
 void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                       const std::vector<cv::Point2d>& view2, const cv::Matx33d& F0, double vote_px,
                       const PlaneParams& params, const Energy& energy) {
@@ -421,34 +349,31 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   cv::Matx33d u, vt;
   cv::SVD::compute(*F, sv, u, vt);
   const cv::Vec3d e(u(0, 2), u(1, 2), u(2, 2));  // F^T e = 0
-  const InducedFamily family{cv::Matx33d(0, -e[2], e[1], e[2], 0, -e[0], -e[1], e[0], 0) * *F, e};
-  auto ownNoise = [&](HomographyPlane& plane) {
-    std::vector<bool> mine(view1.size(), false);
-    for (int i : plane.inliers) mine[i] = true;
-    setPlaneNoise(plane, view1, view2, mine, energy, params);
-  };
-  for (size_t k = planes.size(); k-- > 0;) {
-    HomographyPlane& plane = planes[k];
+  const cv::Matx33d A = cv::Matx33d(0, -e[2], e[1], e[2], 0, -e[0], -e[1], e[0], 0) * *F;
+  const double price =
+      5.0 * params.plane_penalty / 8.0 * std::log(static_cast<double>(view1.size()));
+  bool replaced = false;
+  for (HomographyPlane& plane : planes) {
     std::vector<double> w;
     for (int i : plane.inliers) {
       const double r = transferError(plane.H, view1[i], view2[i]) / (2.0 * plane.noise_px);
       w.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
     }
-    const auto Hc = fitInducedHomography(family.A, family.e, select(view1, plane.inliers),
+    const auto Hc = fitInducedHomography(A, e, select(view1, plane.inliers),
                                          select(view2, plane.inliers), w);
-    if (!Hc) {  // its points do not fix a plane (collinear through the epipole): no plane
-      planes.erase(planes.begin() + static_cast<long>(k));
-      continue;
+    if (!Hc) continue;
+    HomographyPlane induced = plane;
+    induced.H = *Hc;
+    const double extra = energy.sum(induced, plane.inliers, view1, view2) -
+                         energy.sum(plane, plane.inliers, view1, view2);
+    if (extra <= price) {
+      plane.H = *Hc;
+      replaced = true;
     }
-    plane.H = *Hc;
-    ownNoise(plane);
   }
-  mergeSamePlanes(planes, view1, view2, params, energy, &family);
+  if (!replaced) return;
   std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
-  for (size_t k = 0; k < planes.size(); ++k) {
-    planes[k].inliers = std::move(members[k]);
-    ownNoise(planes[k]);  // the scale reported is the one of its final points
-  }
+  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
 }
 
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
@@ -597,7 +522,23 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
 bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params) {
-  return refitWith(H, inliers, view1, view2, active, params, freeFit());
+  for (int round = 0; round < params.refit_iterations; ++round) {
+    std::vector<double> weights;
+    if (params.robust_refit) {
+      for (int i : inliers) {
+        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
+        weights.push_back(1.0 / (1.0 + r * r));
+      }
+    }
+    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
+    if (!fitted) return false;
+    H = *fitted;
+    std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
+    if (next.size() < 4) return false;
+    if (next == inliers) break;
+    inliers = std::move(next);
+  }
+  return true;
 }
 
 Thresholds fixedThresholds(const PlaneParams& params) {

@@ -347,10 +347,10 @@ RealScene readScene(const std::string& name) {
 }  // namespace
 
 // Real images, default settings, five seeds: AdelaideRMF sene (2 planes, 47 % outliers)
-// and elderhallb (3 planes, 48 % outliers). Measured: sene 2.0 % every seed (the paper's
-// fixed 2 px: 6.4 %), elderhallb 5.5 % mean over seeds 1-5, worst 7.5 % (7.4 % over 20
-// seeds, worst 16 %: two of its planes meet at a shallow angle; fixed 2 px: 8.2 %, worst
-// 12.6 %).
+// and elderhallb (3 planes, 48 % outliers). Measured: sene 3.0 % mean, worst 3.6 % (the
+// paper's fixed 2 px: 6.4 %), elderhallb 4.1 % mean over seeds 1-5, worst 6.7 % (5.9 %
+// over 20 seeds, worst 17 %: two of its planes meet at a shallow angle; fixed 2 px:
+// 8.2 %, worst 12.6 %).
 TEST(SegmentPlanes, RealScenesBelowAMisclassificationBound) {
   for (const auto& [name, mean_bound, worst_bound] :
        {std::make_tuple("adelaidermf_sene", 0.04, 0.05),
@@ -412,12 +412,12 @@ cv::Point2d apply(const cv::Matx33d& H, const cv::Point2d& p) {
 // SIFT matches undistorted by plane_pair --matches), seeds 1-20. A plane's homography is
 // plane-induced when the median over its points of the distance between its transfer and
 // the one the pose induces (n/d by least squares on H, as scripts/eval_euroc) is below
-// 1.5 px. Before the induced-only rule (8bea236): 11 of 55 planes not induced, among them
-// planes of 60-69 points (a strip of floor tape, far left, as its own plane at 2.36 px);
-// with the draw of several fifth points per four but without the rule: 7 of 49 (46-74
-// points among them). Now: 3 of 47, of 19-20 points (matches in the bottom left corner
-// where the lens model is poorest, undistorted x < 0).
-TEST(SegmentPlanes, RealStereoPairOnlyPlaneInducedHomographies) {
+// 1.5 px. The floor must be found and induced in every seed. Not every plane is: 7 of 49
+// here (8bea236: 11 of 55), of 16-74 points (a strip of floor tape, small clusters in the
+// bottom left corner where the lens model is poorest); an induced-only rule that brought
+// it to 3 of 47 lost a wall of the furnished room (docs/plane_core.md), so the bound
+// below guards today's figure.
+TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
   std::ifstream txt(std::string(TEST_DATA_DIR) + "/euroc_1403715274212143104.txt");
   const Correspondences c = readCorrespondences(txt);
   ASSERT_TRUE(c.error.empty()) << c.error;
@@ -439,6 +439,7 @@ TEST(SegmentPlanes, RealStereoPairOnlyPlaneInducedHomographies) {
     // (Seed 3 ends with the floor only: F from one plane is undetermined.)
     if (r.planes.size() > 1) EXPECT_TRUE(r.epipolar_checked) << "seed " << seed;
     size_t floor = 0;
+    double floor_induced = 1e9;
     for (size_t k = 0; k < r.planes.size(); ++k) {
       const HomographyPlane& p = r.planes[k];
       const cv::Matx33d Hp = inducedByPose(p.H, K0, K1, R, t);
@@ -453,17 +454,18 @@ TEST(SegmentPlanes, RealStereoPairOnlyPlaneInducedHomographies) {
       const double induced = d[d.size() / 2];
       std::printf("seed %u plane %zu: %zu points, mean y %.0f, induced %.2f px\n", seed, k + 1,
                   p.inliers.size(), mean_y, induced);
-      if (induced >= 1.5) {
-        ++not_induced;
-        EXPECT_LT(p.inliers.size(), 60u) << "seed " << seed << " plane " << k + 1;
-      }
+      not_induced += induced >= 1.5;
       // The floor fills the image's lower part; nothing else there is as large.
-      if (mean_y > 300.0) floor = std::max(floor, p.inliers.size());
+      if (mean_y > 300.0 && p.inliers.size() > floor) {
+        floor = p.inliers.size();
+        floor_induced = induced;
+      }
     }
-    EXPECT_GE(floor, 150u) << "seed " << seed;  // 153-300 (in two pieces in 2 seeds)
+    EXPECT_GE(floor, 150u) << "seed " << seed;  // 204-295
+    EXPECT_LT(floor_induced, 1.5) << "seed " << seed;  // 0.07-0.13 px
   }
   std::printf("not induced: %d planes over 20 seeds\n", not_induced);
-  EXPECT_LE(not_induced, 5);
+  EXPECT_LE(not_induced, 8);
 }
 
 // max_planes caps the planes found, whichever move adds them (the vote, the split move):

@@ -38,9 +38,9 @@ struct PlaneParams {
   int noise_pilot_groups = 20;          // candidate first planes the noise scale is taken from
   // Only plane-induced homographies: F by RANSAC on the points of the planes found, and
   // when it is determined, a plane most of whose points are off their epipolar lines
-  // (beyond the vote's threshold) is dropped, each plane's homography is replaced by the
-  // best one F admits on its points, and pieces of one plane merge when one induced
-  // homography pays for both (planes/epipolar_check.h, docs/plane_core.md).
+  // (beyond the vote's threshold) is dropped, and each plane's homography is replaced by
+  // the best one F admits when that costs no more than the 5 parameters it saves
+  // (planes/epipolar_check.h, docs/plane_core.md).
   bool epipolar_check = true;
 };
 
