@@ -219,9 +219,14 @@ int main(int argc, char** argv) {
       if (report_every > 0 && (k + 1) % report_every == 0)
         std::printf(
             "  frame %d: %s, %zu image planes, %zu map planes, %zu points, "
-            "position error %.3f m\n",
+            "position error %.3f m%s\n",
             k + 1, result.status.c_str(), result.planes.size(), pipeline.map().planes().size(),
-            frame.ids.size(), frame_err);
+            frame.ids.size(), frame_err,
+            result.pose && floor_start
+                ? cv::format(", map position (%.3f %.3f %.3f)", result.pose->map_from_camera.t[0],
+                             result.pose->map_from_camera.t[1], result.pose->map_from_camera.t[2])
+                      .c_str()
+                : "");
     }
     const double rss = currentRssMb();
     std::printf(
@@ -242,8 +247,14 @@ int main(int argc, char** argv) {
         pos_err_max = std::max(pos_err_max, err);
       }
       const cv::Vec3d up = truth_from_map->R * cv::Vec3d(0, 1, 0);
-      std::printf("camera_height: metric from image %d, map up tilted %.2f deg\n", first_posed,
-                  std::acos(std::min(1.0, up[1])) * 180 / CV_PI);
+      double y_min = 1e9, y_max = -1e9;
+      for (const cv::Vec3d& e : est_map) {
+        y_min = std::min(y_min, e[1]);
+        y_max = std::max(y_max, e[1]);
+      }
+      std::printf("camera_height: metric from image %d, map up tilted %.2f deg, camera height "
+                  "in the map %.3f..%.3f m\n",
+                  first_posed, std::acos(std::min(1.0, up[1])) * 180 / CV_PI, y_min, y_max);
     }
     std::printf(
         "camera: placed in %d/%d frames, position error mean %.3f m, max %.3f m, "
