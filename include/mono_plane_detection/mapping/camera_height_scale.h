@@ -36,7 +36,7 @@ struct FloorParams {
   // the camera has moved this far (camera heights) and the floor has min_check_points
   // landmarks. A start whose floor disagrees (by max_check_angle_deg, or a scale off by
   // max_check_scale) is undone.
-  double check_motion = 0.5;
+  double check_motion = 1.0;
   int min_check_points = 30;
   double max_check_angle_deg = 6;
   double max_check_scale = 0.25;     // |scale - 1| at most this
