@@ -91,7 +91,8 @@ class PoseEstimator {
   // it has been seen, before the two-view start).
   // camera_height: not while the start is being checked against the floor landmarks.
   bool scaleKnown() const { return metric_ != MetricSource::kNone && !floor_check_; }
-  MetricSource metricSource() const { return metric_; }
+  // kNone while a camera_height start is being checked (nothing metric is given out).
+  MetricSource metricSource() const { return scaleKnown() ? metric_ : MetricSource::kNone; }
   // What the start waits for, for people ("waiting for target", ...).
   std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
