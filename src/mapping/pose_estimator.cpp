@@ -142,7 +142,7 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
     const std::optional<PoseEstimate> start = startFromFloor(frame, normalized);
     if (!start) return {};
     // Not given out before the floor landmarks have checked it (checkFloor).
-    floor_check_ = FloorCheck{{start->map_from_camera.t}, cv::Vec3d(0, 1, 0), 1};
+    floor_check_ = FloorCheck{{start->map_from_camera.t}, cv::Vec3d(0, 1, 0)};
     floor_reason_ = "floor found, checking it against the map's floor";
     return {};
   }
@@ -195,10 +195,10 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   FloorCheck& check = *floor_check_;
   const FloorParams& p = params_.floor;
   check.cameras.push_back(estimate.map_from_camera.t);
-  ++check.images;
   // Motion in the start's units (near metres): the floor landmarks need views apart.
   double moved = 0;
-  for (const cv::Vec3d& c : check.cameras) moved = std::max(moved, cv::norm(c - check.cameras.front()));
+  for (const cv::Vec3d& c : check.cameras)
+    moved = std::max(moved, cv::norm(c - check.cameras.front()));
   if (moved < p.check_motion * p.camera_height_m) {
     floor_reason_ = "floor found, checking it: waiting for camera motion";
     return false;
@@ -215,7 +215,8 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   // Floor landmarks within 3 % of the height (the rendered floor's fit rms: 1.5 cm at 0.8 m).
   const FloorFit fit = fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
                                            p.max_check_angle_deg, 0.03 * p.camera_height_m,
-                                           p.min_check_points, p.check_camera_sigma * p.camera_height_m);
+                                           p.min_check_points,
+                                           p.check_camera_sigma * p.camera_height_m);
   if (!fit.ok) {
     // No floor within max_check_angle_deg of the start's: after three times the motion
     // the start was wrong (or the floor left the view), it is undone.

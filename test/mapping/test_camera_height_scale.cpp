@@ -123,7 +123,8 @@ TiltedMap tiltedMap(double tilt_deg, double camera_height, bool pitch = false) {
   const cv::Vec3d e2 = m.up.cross(e1);
   cv::RNG rng(7);
   for (int i = 0; i < 80; ++i) {
-    const cv::Vec3d p = m.offset * m.up + rng.uniform(-1.5, 1.5) * e2 + rng.uniform(-2.2, -1.6) * e1;
+    const cv::Vec3d p =
+        m.offset * m.up + rng.uniform(-1.5, 1.5) * e2 + rng.uniform(-2.2, -1.6) * e1;
     m.points.push_back(p + rng.gaussian(0.005) * m.up);
     m.sigma.push_back(0.005);
   }

@@ -167,8 +167,7 @@ class PoseEstimator {
   // camera_height: after the start, until the floor landmarks confirm and correct it.
   struct FloorCheck {
     std::vector<cv::Vec3d> cameras;  // positions since the start, map frame
-    cv::Vec3d start_up{0, 1, 0};
-    int images = 0;
+    cv::Vec3d start_up{0, 1, 0};     // the map's up as the start set it
   };
   std::optional<FloorCheck> floor_check_;
 };
