@@ -272,7 +272,9 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
       const auto e = estimator.update(withoutTarget(world.frame(t)));
       if (!e) {
         // Waiting for the floor or checking it: no metric source is reported yet.
-        if (posed == 0) EXPECT_EQ(estimator.metricSource(), MetricSource::kNone);
+        if (posed == 0) {
+          EXPECT_EQ(estimator.metricSource(), MetricSource::kNone);
+        }
         continue;
       }
       // Poses only once the start has been checked against the floor landmarks.
