@@ -222,4 +222,138 @@ Pose floorMapFromCamera(const cv::Vec3d& down, double camera_height_m) {
   return camera_from_map.inverse();
 }
 
+namespace {
+
+// Weighted total least squares for two parallel planes sharing one normal (oriented
+// like `towards`): the landmarks' floor and the plane of the camera positions (a wheeled
+// camera stays at one height). Each group is centred on its own weighted centroid; the
+// normal is the smallest eigenvector of their summed scatter.
+bool fitPlane(const std::vector<cv::Vec3d>& points, const std::vector<double>& weight,
+              const std::vector<int>& use, const std::vector<cv::Vec3d>& cameras,
+              double camera_weight, const cv::Vec3d& towards, cv::Vec3d& up, double& offset) {
+  double w_sum = 0;
+  cv::Vec3d centre(0, 0, 0), camera_centre(0, 0, 0);
+  for (int i : use) {
+    w_sum += weight[i];
+    centre += weight[i] * points[i];
+  }
+  if (use.size() < 3 || !(w_sum > 0)) return false;
+  centre /= w_sum;
+  for (const cv::Vec3d& c : cameras) camera_centre += c / static_cast<double>(cameras.size());
+  cv::Matx33d C = cv::Matx33d::zeros();
+  for (int i : use) {
+    const cv::Vec3d d = points[i] - centre;
+    C += weight[i] * d * d.t();
+  }
+  for (const cv::Vec3d& c : cameras) {
+    const cv::Vec3d d = c - camera_centre;
+    C += camera_weight * d * d.t();
+  }
+  cv::Matx31d values;
+  cv::Matx33d vectors;
+  cv::eigen(C, values, vectors);
+  cv::Vec3d n(vectors(2, 0), vectors(2, 1), vectors(2, 2));  // smallest eigenvalue
+  if (n.dot(towards) < 0) n = -n;
+  up = unit(n);
+  offset = up.dot(centre);
+  return true;
+}
+
+}  // namespace
+
+FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
+                             const std::vector<double>& sigma_m,
+                             const std::vector<cv::Vec3d>& cameras, const cv::Vec3d& up,
+                             double max_angle_deg, double tolerance_m, int min_points,
+                             double camera_sigma_m) {
+  FloorFit out;
+  const int n = static_cast<int>(points.size());
+  if (n < std::max(3, min_points) || sigma_m.size() != points.size() || cameras.empty()) {
+    out.reason = "too few landmarks";
+    return out;
+  }
+  // A landmark's own noise widens its gate, up to twice the tolerance: the floor's far
+  // edge meets a wall, whose lowest points a generous gate would tilt the floor to.
+  auto gate = [&](int i) { return std::min(2 * tolerance_m, std::max(tolerance_m, sigma_m[i])); };
+  // Below every camera: the floor is under the robot.
+  auto below = [&](const cv::Vec3d& u, double offset) {
+    for (const cv::Vec3d& c : cameras)
+      if (u.dot(c) - offset <= tolerance_m) return false;
+    return true;
+  };
+  // RANSAC over triples, deterministic (a fixed generator): repeatable maps.
+  cv::RNG rng(12345);
+  int best_count = 0;
+  cv::Vec3d best_up = unit(up);
+  double best_offset = 0;
+  const double cos_max = std::cos(max_angle_deg * CV_PI / 180);
+  for (int iter = 0; iter < 500; ++iter) {
+    const int a = rng.uniform(0, n), b = rng.uniform(0, n), c = rng.uniform(0, n);
+    if (a == b || b == c || a == c) continue;
+    cv::Vec3d u = (points[b] - points[a]).cross(points[c] - points[a]);
+    if (cv::norm(u) < 1e-9) continue;
+    u = unit(u);
+    if (u.dot(up) < 0) u = -u;
+    if (u.dot(unit(up)) < cos_max) continue;
+    const double offset = u.dot(points[a]);
+    if (!below(u, offset)) continue;
+    int count = 0;
+    for (int i = 0; i < n; ++i) count += std::abs(u.dot(points[i]) - offset) <= gate(i);
+    if (count > best_count) {
+      best_count = count;
+      best_up = u;
+      best_offset = offset;
+    }
+  }
+  if (best_count < min_points) {
+    out.reason = "no floor among the landmarks";
+    return out;
+  }
+  std::vector<double> weight(points.size());
+  for (int i = 0; i < n; ++i) weight[i] = 1.0 / std::max(1e-6, sigma_m[i] * sigma_m[i]);
+  const double camera_weight =
+      camera_sigma_m > 0 ? 1.0 / (camera_sigma_m * camera_sigma_m) : 0.0;
+  cv::Vec3d fit_up = best_up;
+  double offset = best_offset;
+  std::vector<int> use;
+  for (int round = 0; round < 3; ++round) {
+    use.clear();
+    for (int i = 0; i < n; ++i)
+      if (std::abs(fit_up.dot(points[i]) - offset) <= gate(i)) use.push_back(i);
+    if (static_cast<int>(use.size()) < min_points ||
+        !fitPlane(points, weight, use, cameras, camera_weight, best_up, fit_up, offset)) {
+      out.reason = "no floor among the landmarks";
+      return out;
+    }
+  }
+  double sq = 0;
+  for (int i : use) sq += std::pow(fit_up.dot(points[i]) - offset, 2);
+  out.ok = true;
+  out.up = fit_up;
+  out.offset = offset;
+  out.inliers = use;
+  out.rms_m = std::sqrt(sq / static_cast<double>(use.size()));
+  return out;
+}
+
+Similarity floorCorrection(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras,
+                           const cv::Vec3d& origin_camera, double camera_height_m) {
+  Similarity s;
+  // The smallest rotation taking the floor's up onto +y (Rodrigues about their cross).
+  const cv::Vec3d y(0, 1, 0), axis = floor.up.cross(y);
+  const double sin_a = cv::norm(axis), cos_a = floor.up.dot(y);
+  if (sin_a > 1e-12) {
+    const cv::Vec3d r = axis / sin_a * std::atan2(sin_a, cos_a);
+    cv::Rodrigues(r, s.R);
+  }
+  std::vector<double> heights;
+  for (const cv::Vec3d& c : cameras) heights.push_back(floor.up.dot(c) - floor.offset);
+  const double height = heights.empty() ? 0 : median(heights);
+  s.scale = height > 0 ? camera_height_m / height : 1.0;
+  // Floor at y = 0, the origin below origin_camera.
+  const cv::Vec3d o = s.scale * (s.R * origin_camera);
+  s.t = cv::Vec3d(-o[0], -s.scale * floor.offset, -o[2]);
+  return s;
+}
+
 }  // namespace mono_plane_detection

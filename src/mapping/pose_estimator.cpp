@@ -63,7 +63,7 @@ bool PoseEstimator::allows(MetricSource source) const {
 }
 
 std::string PoseEstimator::waitingFor() const {
-  if (metric_ != MetricSource::kNone) return {};
+  if (scaleKnown()) return {};
   std::string what;
   if (allows(MetricSource::kTarget)) what = "target";
   if (allows(MetricSource::kOdometry)) what += std::string(what.empty() ? "" : " or ") + "odometry";
@@ -87,6 +87,7 @@ void PoseEstimator::reset() {
   metric_ = MetricSource::kNone;
   floor_reason_.clear();
   floor_views_.clear();
+  floor_check_.reset();
 }
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
@@ -139,9 +140,11 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   if (metric_ == MetricSource::kNone) {
     if (!allows(MetricSource::kCameraHeight)) return {};  // no metres without a source
     const std::optional<PoseEstimate> start = startFromFloor(frame, normalized);
-    if (start && odom_from_camera)
-      map_from_odom_ = start->map_from_camera * odom_from_camera->inverse();
-    return start;
+    if (!start) return {};
+    // Not given out before the floor landmarks have checked it (checkFloor).
+    floor_check_ = FloorCheck{{start->map_from_camera.t}, cv::Vec3d(0, 1, 0)};
+    floor_reason_ = "floor found, checking it against the map's floor";
+    return {};
   }
   if (!initialised_) {  // nothing is triangulated before the start
     const std::optional<PoseEstimate> start = initialise(frame, normalized);
@@ -161,7 +164,10 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
     estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
   else
     estimate = visualPose(frame, normalized);
-  if (!estimate) return {};
+  if (!estimate) {
+    if (floor_check_) undoFloorStart("lost while checking the floor");
+    return {};
+  }
   last_pose_ = estimate->map_from_camera;
   for (size_t i = 0; i < frame.ids.size(); ++i) {
     const auto it = landmarks_.find(frame.ids[i]);
@@ -169,7 +175,74 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   }
   triangulate(frame, normalized, estimate->map_from_camera);
   forgetOldLandmarks();
+  if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) return {};
   return estimate;
+}
+
+void PoseEstimator::undoFloorStart(const std::string& why) {
+  landmarks_.clear();
+  last_pose_.reset();
+  map_from_odom_.reset();
+  initialised_ = false;
+  metric_ = MetricSource::kNone;
+  floor_views_.clear();
+  floor_check_.reset();
+  floor_reason_ = why;
+}
+
+bool PoseEstimator::checkFloor(PoseEstimate& estimate,
+                               const std::optional<Pose>& odom_from_camera) {
+  FloorCheck& check = *floor_check_;
+  const FloorParams& p = params_.floor;
+  check.cameras.push_back(estimate.map_from_camera.t);
+  // Motion in the start's units (near metres): the floor landmarks need views apart.
+  double moved = 0;
+  for (const cv::Vec3d& c : check.cameras)
+    moved = std::max(moved, cv::norm(c - check.cameras.front()));
+  if (moved < p.check_motion * p.camera_height_m) {
+    floor_reason_ = "floor found, checking it: waiting for camera motion";
+    return false;
+  }
+  std::vector<cv::Vec3d> points;
+  std::vector<double> sigma;
+  const double angle = 1.0 / K_(0, 0);  // a pixel
+  for (const auto& [id, l] : landmarks_) {
+    if (!l.triangulated || l.provisional || l.parallax_deg <= 0) continue;
+    points.push_back(l.position);
+    const double depth = cv::norm(l.position - l.anchor_pose.t);
+    sigma.push_back(depth * angle / std::sin(l.parallax_deg * CV_PI / 180));
+  }
+  // Floor landmarks within 3 % of the height (the rendered floor's fit rms: 1.5 cm at 0.8 m).
+  const FloorFit fit = fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
+                                           p.max_check_angle_deg, 0.03 * p.camera_height_m,
+                                           p.min_check_points,
+                                           p.check_camera_sigma * p.camera_height_m);
+  if (!fit.ok) {
+    // No floor within max_check_angle_deg of the start's: after three times the motion
+    // the start was wrong (or the floor left the view), it is undone.
+    if (moved > 3 * p.check_motion * p.camera_height_m)
+      undoFloorStart("the map shows no floor like the start's: started again");
+    else
+      floor_reason_ = "floor found, checking it: " + fit.reason;
+    return false;
+  }
+  const Similarity s =
+      floorCorrection(fit, check.cameras, check.cameras.front(), p.camera_height_m);
+  if (angleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
+      std::abs(s.scale - 1) > p.max_check_scale) {
+    undoFloorStart("the start's floor disagreed with the map's floor: started again");
+    return false;
+  }
+  for (auto& [id, l] : landmarks_) {
+    l.position = s.apply(l.position);
+    l.anchor_pose = s.apply(l.anchor_pose);
+  }
+  estimate.map_from_camera = s.apply(estimate.map_from_camera);
+  last_pose_ = estimate.map_from_camera;
+  if (odom_from_camera) map_from_odom_ = estimate.map_from_camera * odom_from_camera->inverse();
+  floor_check_.reset();
+  floor_reason_.clear();
+  return true;
 }
 
 std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,

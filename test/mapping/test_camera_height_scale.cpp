@@ -98,3 +98,113 @@ TEST(CameraHeightScale, FloorMapFrame) {
   EXPECT_NEAR(ahead[1], -std::sin(pitch), 1e-12);                   // looking down
   EXPECT_NEAR(ahead[0], 0, 1e-12);
 }
+
+namespace {
+
+// A map's floor (3 deg tilted, 0.1 m below y = 0) as a strip of landmarks ahead of the
+// cameras, the lowest part of a wall meeting it, and the cameras 0.84 m above the floor
+// moving along it: the map a start with its up and scale a little off gives.
+struct TiltedMap {
+  cv::Vec3d up;
+  double offset = -0.1;
+  std::vector<cv::Vec3d> points, cameras;
+  std::vector<double> sigma;
+  size_t floor_points = 0;
+};
+
+// pitch: tilted about the strip's long axis (the strip, 0.6 m deep, fixes that poorly);
+// else about the direction of motion (a roll).
+TiltedMap tiltedMap(double tilt_deg, double camera_height, bool pitch = false) {
+  TiltedMap m;
+  const double a = tilt_deg * CV_PI / 180;
+  m.up = pitch ? cv::Vec3d(0, std::cos(a), std::sin(a)) : cv::Vec3d(std::sin(a), std::cos(a), 0);
+  cv::Vec3d e1 = cv::Vec3d(0, 0, 1) - m.up[2] * m.up;  // along the floor, backwards
+  e1 /= cv::norm(e1);
+  const cv::Vec3d e2 = m.up.cross(e1);
+  cv::RNG rng(7);
+  for (int i = 0; i < 80; ++i) {
+    const cv::Vec3d p =
+        m.offset * m.up + rng.uniform(-1.5, 1.5) * e2 + rng.uniform(-2.2, -1.6) * e1;
+    m.points.push_back(p + rng.gaussian(0.005) * m.up);
+    m.sigma.push_back(0.005);
+  }
+  m.floor_points = m.points.size();
+  for (int i = 0; i < 30; ++i) {  // the wall at z = -2.2: from 6 cm to 0.3 m up
+    const cv::Vec3d p = m.offset * m.up + rng.uniform(-1.5, 1.5) * e2 - 2.2 * e1 +
+                        rng.uniform(0.06, 0.3) * m.up;
+    m.points.push_back(p);
+    m.sigma.push_back(0.005);
+  }
+  for (int i = 0; i < 40; ++i)  // driving 0.4 m along -z
+    m.cameras.push_back((m.offset + camera_height) * m.up - 0.01 * i * e1);
+  return m;
+}
+
+}  // namespace
+
+TEST(CameraHeightScale, FloorFittedToTheMapsLandmarks) {
+  const TiltedMap m = tiltedMap(3.0, 0.84);
+  const FloorFit fit =
+      fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30, 0.008);
+  ASSERT_TRUE(fit.ok) << fit.reason;
+  EXPECT_LT(angleDeg(fit.up, m.up), 0.3);
+  EXPECT_NEAR(fit.offset, m.offset, 0.01);  // the strip 2 m ahead: 0.3 deg there is 1 cm
+  // The wall's points are not the floor.
+  size_t wall = 0;
+  for (int i : fit.inliers) wall += static_cast<size_t>(i) >= m.floor_points;
+  EXPECT_EQ(wall, 0u);
+  EXPECT_GE(fit.inliers.size(), 75u);
+
+  // The correction puts the floor at y = 0, the cameras 0.8 m above it, the origin
+  // below the first camera.
+  const Similarity s = floorCorrection(fit, m.cameras, m.cameras.front(), 0.8);
+  EXPECT_NEAR(s.scale, 0.8 / 0.84, 0.01);
+  for (size_t i = 0; i < m.floor_points; ++i) EXPECT_NEAR(s.apply(m.points[i])[1], 0, 0.02);
+  for (const cv::Vec3d& c : m.cameras) EXPECT_NEAR(s.apply(c)[1], 0.8, 0.01);
+  EXPECT_NEAR(s.apply(m.cameras.front())[0], 0, 1e-9);
+  EXPECT_NEAR(s.apply(m.cameras.front())[2], 0, 1e-9);
+  EXPECT_NEAR(cv::determinant(s.R), 1, 1e-9);
+  const Pose moved = s.apply(Pose{cv::Matx33d::eye(), m.cameras.back()});
+  EXPECT_NEAR(cv::norm(moved.t - s.apply(m.cameras.back())), 0, 1e-12);
+}
+
+TEST(CameraHeightScale, NoFloorLikeTheStartsIsFound) {
+  // A start 12 deg off: no floor within 6 deg of its up (the start is then undone).
+  const TiltedMap m = tiltedMap(12.0, 0.84);
+  const FloorFit fit =
+      fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30, 0.008);
+  EXPECT_FALSE(fit.ok);
+  EXPECT_FALSE(fit.reason.empty());
+  // Too few landmarks, or none below the cameras: no floor either.
+  EXPECT_FALSE(fitFloorToLandmarks({}, {}, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30).ok);
+  const TiltedMap low = tiltedMap(0.0, -0.5);  // cameras below the "floor"
+  EXPECT_FALSE(
+      fitFloorToLandmarks(low.points, low.sigma, low.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30).ok);
+}
+
+TEST(CameraHeightScale, TheCamerasPathFixesTheStripsTilt) {
+  // A strip of noisy floor (3 cm, as far landmarks are) tilted about its long axis: the
+  // cameras' motion along the floor fixes that tilt.
+  double alone_sum = 0, with_sum = 0;
+  for (int seed = 0; seed < 10; ++seed) {
+    TiltedMap m = tiltedMap(3.0, 0.84, true);
+    cv::RNG rng(seed);
+    for (size_t i = 0; i < m.floor_points; ++i) {
+      m.points[i] += rng.gaussian(0.03) * m.up;
+      m.sigma[i] = 0.03;
+    }
+    m.points.resize(m.floor_points);
+    m.sigma.resize(m.floor_points);
+    const cv::Vec3d guess(0, 1, 0);
+    const FloorFit alone = fitFloorToLandmarks(m.points, m.sigma, m.cameras, guess, 6, 0.1, 30);
+    const FloorFit with =
+        fitFloorToLandmarks(m.points, m.sigma, m.cameras, guess, 6, 0.1, 30, 0.008);
+    ASSERT_TRUE(alone.ok && with.ok);
+    alone_sum += angleDeg(alone.up, m.up);
+    with_sum += angleDeg(with.up, m.up);
+  }
+  std::printf("strip: floor alone %.2f deg off, with the cameras %.2f deg (mean of 10)\n",
+              alone_sum / 10, with_sum / 10);
+  EXPECT_LT(with_sum, 0.5 * alone_sum);
+  EXPECT_LT(with_sum / 10, 1.0);
+}

@@ -31,6 +31,18 @@ struct FloorParams {
   int confirmations = 5;             // images in a row that find the same floor ...
   double max_floor_change_deg = 4;   // ... its down direction changing less than this
   double max_error_px = 3.0;         // RANSAC threshold: 3 sigma of the measured noise, at most this
+  // After the start the map is checked and corrected against the floor landmarks it
+  // triangulates (fitFloorToLandmarks, floorCorrection) before a pose is given out: once
+  // the camera has moved this far (camera heights) and the floor has min_check_points
+  // landmarks. A start whose floor disagrees (by max_check_angle_deg, or a scale off by
+  // max_check_scale) is undone.
+  double check_motion = 1.0;
+  int min_check_points = 30;
+  double max_check_angle_deg = 6;
+  double max_check_scale = 0.25;     // |scale - 1| at most this
+  // The camera positions' noise in that fit (camera heights): a wheeled camera stays at
+  // one height, so its path shares the floor's normal (fitFloorToLandmarks).
+  double check_camera_sigma = 0.01;
 };
 
 struct FloorStart {
@@ -55,5 +67,45 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
 // first camera, y up (against `down`), z backwards along the floor (so the ROS map's x
 // is the camera's heading at the start). map_from_first camera.
 Pose floorMapFromCamera(const cv::Vec3d& down, double camera_height_m);
+
+// The floor {x : up . x = offset} fitted to a map's landmarks (map frame): of the
+// planes through three of them whose normal lies within max_angle_deg of `up` (the
+// map's up as started) and that lie below every camera, the one with the most landmarks
+// within tolerance_m (each landmark's own sigma_m also counts: 3 sigma), then refined by
+// weighted total least squares on those (weights 1 / sigma^2) and their inliers again.
+// camera_sigma_m > 0: the cameras stay at one height (a wheeled robot), their positions
+// (noise camera_sigma_m) share the floor's normal: a floor seen as a strip ahead fixes
+// its tilt about the strip poorly, the camera's motion along the floor fixes that.
+struct FloorFit {
+  bool ok = false;
+  std::string reason;            // why not, when !ok
+  cv::Vec3d up{0, 1, 0};         // unit, from the floor towards the cameras
+  double offset = 0;             // m: the floor is up . x = offset
+  std::vector<int> inliers;      // indices into the points
+  double rms_m = 0;              // the inliers' distance from the floor
+};
+FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
+                             const std::vector<double>& sigma_m,
+                             const std::vector<cv::Vec3d>& cameras, const cv::Vec3d& up,
+                             double max_angle_deg, double tolerance_m, int min_points,
+                             double camera_sigma_m = 0);
+
+// x' = scale * R * x + t: a similarity of the map.
+struct Similarity {
+  double scale = 1;
+  cv::Matx33d R = cv::Matx33d::eye();
+  cv::Vec3d t{0, 0, 0};
+  cv::Vec3d apply(const cv::Vec3d& x) const { return scale * (R * x) + t; }
+  // A camera pose (map_from_camera) moved with the map.
+  Pose apply(const Pose& map_from_camera) const {
+    return {R * map_from_camera.R, apply(map_from_camera.t)};
+  }
+};
+
+// The similarity that puts a map's floor (its fit) at y = 0 with +y up (the smallest
+// rotation of its up), and the cameras (positions, map frame) camera_height_m above it
+// (the median of their heights), the origin staying below `origin_camera`.
+Similarity floorCorrection(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras,
+                           const cv::Vec3d& origin_camera, double camera_height_m);
 
 }  // namespace mono_plane_detection

@@ -89,8 +89,10 @@ class PoseEstimator {
 
   // True once a metric source has started: poses are in metres (for the target: once
   // it has been seen, before the two-view start).
-  bool scaleKnown() const { return metric_ != MetricSource::kNone; }
-  MetricSource metricSource() const { return metric_; }
+  // camera_height: not while the start is being checked against the floor landmarks.
+  bool scaleKnown() const { return metric_ != MetricSource::kNone && !floor_check_; }
+  // kNone while a camera_height start is being checked (nothing metric is given out).
+  MetricSource metricSource() const { return scaleKnown() ? metric_ : MetricSource::kNone; }
   // What the start waits for, for people ("waiting for target", ...).
   std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
@@ -122,6 +124,11 @@ class PoseEstimator {
   void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                           const Pose& map_from_camera);
   void forgetOldLandmarks();
+  // camera_height: checks the start against the floor its landmarks show; true once the
+  // map has been corrected (poses may be given out), false while waiting; undoes the
+  // start when the floor disagrees.
+  bool checkFloor(PoseEstimate& estimate, const std::optional<Pose>& odom_from_camera);
+  void undoFloorStart(const std::string& why);
 
   struct FirstView {  // the image the two-view start measures motion from
     std::vector<std::uint64_t> ids;
@@ -157,6 +164,12 @@ class PoseEstimator {
   // time the tracks have moved 1 % of the focal length, at most 20), dropped when they
   // share fewer tracks than a floor needs; the oldest is tried first (most parallax).
   std::deque<FirstView> floor_views_;
+  // camera_height: after the start, until the floor landmarks confirm and correct it.
+  struct FloorCheck {
+    std::vector<cv::Vec3d> cameras;  // positions since the start, map frame
+    cv::Vec3d start_up{0, 1, 0};     // the map's up as the start set it
+  };
+  std::optional<FloorCheck> floor_check_;
 };
 
 }  // namespace mono_plane_detection
