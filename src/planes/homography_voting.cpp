@@ -244,6 +244,7 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
                                                   const std::vector<cv::Point2d>& view1,
                                                   const std::vector<cv::Point2d>& view2,
                                                   const PlaneParams& params, const Energy& energy) {
+  if (planes.empty()) return {};  // (the cost table below would be empty)
   // Each point's cost under each plane once (a plane's costs do not change when another
   // is dropped): cost[i * P + k].
   const size_t n = view1.size();
