@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
@@ -14,12 +15,6 @@ cv::Vec3d ray(const cv::Point2d& n) { return cv::Vec3d(n.x, n.y, 1.0); }
 cv::Vec3d unit(const cv::Vec3d& v) { return v / cv::norm(v); }
 double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
   return std::acos(std::max(-1.0, std::min(1.0, unit(a).dot(unit(b))))) * 180.0 / CV_PI;
-}
-
-// Where the plane n . x = d of the first camera carries a first-image point in the second.
-cv::Point2d transfer(const cv::Matx33d& H, const cv::Point2d& a) {
-  const cv::Vec3d p = H * ray(a);
-  return {p[0] / p[2], p[1] / p[2]};
 }
 
 }  // namespace
@@ -107,7 +102,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
   // of motion) lie on every plane: they are counted for none.
   std::vector<bool> at_infinity(m);
   for (int k = 0; k < m; ++k)
-    at_infinity[k] = cv::norm(transfer(R, first[index[k]]) - second[index[k]]) < 2 * threshold;
+    at_infinity[k] = transfersWithin(R, first[index[k]], second[index[k]], 2 * threshold);
   // Samples only from tracks below the nominal horizon that the rotation does not explain.
   std::vector<int> candidates;
   for (int k = 0; k < m; ++k)
@@ -135,7 +130,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     std::vector<int> inliers;
     int telling = 0;
     for (int k = 0; k < m; ++k)
-      if (cv::norm(transfer(H, first[index[k]]) - second[index[k]]) < 2 * threshold) {
+      if (transfersWithin(H, first[index[k]], second[index[k]], 2 * threshold)) {
         inliers.push_back(k);
         telling += !at_infinity[k];
       }
@@ -182,7 +177,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     const cv::Matx33d H = R + t * m_plane.t();
     std::vector<int> again;
     for (int k = 0; k < m; ++k)
-      if (cv::norm(transfer(H, first[index[k]]) - second[index[k]]) < 2 * threshold) again.push_back(k);
+      if (transfersWithin(H, first[index[k]], second[index[k]], 2 * threshold)) again.push_back(k);
     if (again.size() < best.size() / 2) break;  // the fit went elsewhere: keep the first
     best = again;
   }

@@ -145,14 +145,6 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
 
 namespace {
 
-// wellSpread's test of one triple (the same arithmetic): not (nearly) collinear.
-bool spreadTriple(const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& c,
-                  double min_shape) {
-  const double longest2 = std::max({(a - b).dot(a - b), (b - c).dot(b - c), (a - c).dot(a - c)});
-  const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
-  return longest2 > 0.0 && !(std::abs(det) < min_shape * longest2);
-}
-
 bool finitePoint(const cv::Point2d& q) { return std::isfinite(q.x) && std::isfinite(q.y); }
 
 }  // namespace
@@ -172,13 +164,9 @@ bool GroupSampler::nextFifth(PointGroup& group) {
     for (int i = 0; i < 4; ++i) to_q[i] = (*four[i] - q).dot(*four[i] - q);
     bool ok = true;
     for (int i = 0; ok && i < 4; ++i)
-      for (int j = i + 1; ok && j < 4; ++j) {
-        const cv::Point2d& a = *four[i];
-        const cv::Point2d& b = *four[j];
-        const double longest2 = std::max({four_edge2_[i][j], to_q[j], to_q[i]});
-        const double det = (b.x - a.x) * (q.y - a.y) - (q.x - a.x) * (b.y - a.y);
-        ok = longest2 > 0.0 && !(std::abs(det) < params_.min_shape * longest2);
-      }
+      for (int j = i + 1; ok && j < 4; ++j)
+        ok = spreadTriple(*four[i], *four[j], q, four_edge2_[i][j], to_q[j], to_q[i],
+                          params_.min_shape);
     if (!ok) continue;
     group = {seeds_[four_slot_], near[0], near[1], near[2], f};
     return true;
@@ -217,14 +205,16 @@ bool GroupSampler::next(PointGroup& group) {
                                   &points_[candidates[1]], &points_[candidates[2]]};
     bool ok = true;
     for (int i = 0; ok && i < 4; ++i) ok = finitePoint(*four[i]);
-    for (int i = 0; ok && i < 4; ++i)
-      for (int j = i + 1; ok && j < 4; ++j)
-        for (int k = j + 1; ok && k < 4; ++k)
-          ok = spreadTriple(*four[i], *four[j], *four[k], params_.min_shape);
-    if (ok) {
+    if (ok)  // the four's sides, kept for its fifth points' triples
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
           four_edge2_[i][j] = (*four[i] - *four[j]).dot(*four[i] - *four[j]);
+    for (int i = 0; ok && i < 4; ++i)
+      for (int j = i + 1; ok && j < 4; ++j)
+        for (int k = j + 1; ok && k < 4; ++k)
+          ok = spreadTriple(*four[i], *four[j], *four[k], four_edge2_[i][j], four_edge2_[j][k],
+                            four_edge2_[i][k], params_.min_shape);
+    if (ok) {
       four_slot_ = slot;
       next_fifth_ = 3;
       end_fifth_ = drawn;

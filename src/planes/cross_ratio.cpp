@@ -34,11 +34,9 @@ bool wellSpread(const std::array<cv::Point2d, 5>& p, double min_shape) {
     for (int j = i + 1; j < 5; ++j) edge2[i][j] = (p[i] - p[j]).dot(p[i] - p[j]);
   for (int i = 0; i < 5; ++i)
     for (int j = i + 1; j < 5; ++j)
-      for (int k = j + 1; k < 5; ++k) {
-        const double longest2 = std::max({edge2[i][j], edge2[j][k], edge2[i][k]});
-        if (!(longest2 > 0.0) || std::abs(det3(p[i], p[j], p[k])) < min_shape * longest2)
+      for (int k = j + 1; k < 5; ++k)
+        if (!spreadTriple(p[i], p[j], p[k], edge2[i][j], edge2[j][k], edge2[i][k], min_shape))
           return false;
-      }
   return true;
 }
 

@@ -449,7 +449,7 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
     return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
   };
   // The active points once, coordinates in separate arrays so that the count over a block
-  // of points compiles to vector instructions (as inliersOf counts: no division).
+  // of points compiles to vector instructions (the arithmetic of transfersWithin).
   // The count of a homography stops after the block where the points left can no longer
   // make it beat the best so far (its bound is then what it could still reach).
   std::vector<double> ax, ay, bx, by;
@@ -473,7 +473,7 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
       const int b1 = std::min(m, b0 + kBlock);
       int in_block = 0;
       for (int i = b0; i < b1; ++i) {
-        // |H a / w - b| < t as |H a - w b| < t |w|: no division (the vote's main cost).
+        // transfersWithin's test on the arrays (no division: the vote's main cost).
         const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
         const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
         const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
@@ -503,20 +503,10 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
 std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                            const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                            double threshold_px) {
-  // transfersWithin without its divisions, as the vote counts (the same points on the
-  // AdelaideRMF scenes; this runs in every refit round).
   std::vector<int> inliers;
-  const double t2 = threshold_px * threshold_px;
-  for (size_t i = 0; i < view1.size(); ++i) {
-    if (!isActive(active, i)) continue;
-    const cv::Point2d& a = view1[i];
-    const cv::Point2d& b = view2[i];
-    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
-    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
-    if (std::abs(w) >= 1e-12 && dx * dx + dy * dy < t2 * (w * w))
+  for (size_t i = 0; i < view1.size(); ++i)
+    if (isActive(active, i) && transfersWithin(H, view1[i], view2[i], threshold_px))
       inliers.push_back(static_cast<int>(i));
-  }
   return inliers;
 }
 
@@ -579,17 +569,9 @@ double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& vi
   size_t below = 0;
   const double bound2 = bound * bound;
   for (size_t i = 0; i < view1.size(); ++i) {
-    // transferResiduals' arithmetic, without its allocation.
-    const cv::Point2d& a = view1[i];
-    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-    double e = std::numeric_limits<double>::infinity();
-    if (std::abs(w) >= 1e-12) {
-      const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) / w - view2[i].x;
-      const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) / w - view2[i].y;
-      e = dx * dx + dy * dy;  // squared: the same order, one square root at the end
-    }
-    r[i] = e;
-    below += e < bound2;
+    // Squared: the same order, one square root at the end.
+    r[i] = transferErrorSquared(H, view1[i], view2[i]);
+    below += r[i] < bound2;
   }
   if (below <= kth) return std::numeric_limits<double>::infinity();
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());

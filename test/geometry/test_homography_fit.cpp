@@ -63,6 +63,13 @@ TEST(HomographyFit, TransferErrorAtInfinity) {
   const cv::Matx33d H(1, 0, 0, 0, 1, 0, 1, 0, 0);  // sends x = 0 to infinity
   EXPECT_TRUE(std::isinf(transferError(H, {0, 5}, {0, 0})));
   EXPECT_NEAR(transferError(cv::Matx33d::eye(), {3, 4}, {0, 0}), 5.0, 1e-12);
+  EXPECT_TRUE(std::isinf(transferErrorSquared(H, {0, 5}, {0, 0})));
+  EXPECT_NEAR(transferErrorSquared(cv::Matx33d::eye(), {3, 4}, {0, 0}), 25.0, 1e-12);
+  // A homography with w != 1 (the projective case the division-free test must scale).
+  const cv::Point2d a(30, 40), b = transfer(kH, a) + cv::Point2d(0, 1.5);
+  EXPECT_NEAR(transferErrorSquared(kH, a, b), 2.25, 1e-9);
+  EXPECT_TRUE(transfersWithin(2.0 * kH, a, b, 1.6));  // scale-free, as transferError
+  EXPECT_FALSE(transfersWithin(-3.0 * kH, a, b, 1.4));
 }
 
 namespace {

@@ -79,3 +79,21 @@ TEST(CrossRatio, DistanceIsRelativeAndBounded) {
   EXPECT_NEAR(invariantDistance({1, 2}, {-1, 2}), 2.0, 1e-12);  // opposite signs
   EXPECT_EQ(invariantDistance({0, 0}, {0, 0}), 0.0);
 }
+
+// One triple of wellSpread's test from its squared sides: the same verdict as
+// triangleShape >= min_shape, and as wellSpread for five points.
+TEST(CrossRatio, SpreadTripleIsTriangleShapeFromItsSides) {
+  auto sides = [](const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& c,
+                  double min_shape) {
+    return spreadTriple(a, b, c, (a - b).dot(a - b), (b - c).dot(b - c), (a - c).dot(a - c),
+                        min_shape);
+  };
+  const cv::Point2d a(0, 0), b(10, 0), c(5, 8), flat(5, 0.2);
+  EXPECT_TRUE(sides(a, b, c, 0.05));
+  EXPECT_FALSE(sides(a, b, flat, 0.05));  // shape 0.02
+  EXPECT_TRUE(sides(a, b, flat, 0.01));
+  for (double m : {0.01, 0.019, 0.021, 0.05}) EXPECT_EQ(sides(a, b, flat, m), triangleShape(a, b, flat) >= m);
+  EXPECT_FALSE(sides(a, a, a, 0.05));  // repeated points
+  EXPECT_TRUE(wellSpread({a, b, c, cv::Point2d(-3, 9), cv::Point2d(13, 10)}, 0.05));
+  EXPECT_FALSE(wellSpread({a, b, c, cv::Point2d(-3, 9), flat}, 0.05));
+}

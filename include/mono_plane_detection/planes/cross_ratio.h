@@ -4,7 +4,9 @@
 // cross ratios and needs no line intersections.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <opencv2/core.hpp>
 #include <optional>
 
@@ -23,6 +25,16 @@ double triangleShape(const cv::Point2d& a, const cv::Point2d& b, const cv::Point
 // True when every triple of the five points has triangleShape >= min_shape and all
 // coordinates are finite.
 bool wellSpread(const std::array<cv::Point2d, 5>& p, double min_shape);
+
+// One triple of wellSpread's test, triangleShape(a, b, c) >= min_shape, given its squared
+// side lengths |a - b|^2, |b - c|^2, |a - c|^2 (callers testing triples that share sides
+// measure each side once). Inline: the group draw runs it for every group tried.
+inline bool spreadTriple(const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& c,
+                         double ab2, double bc2, double ac2, double min_shape) {
+  const double longest2 = std::max({ab2, bc2, ac2});
+  const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+  return longest2 > 0.0 && !(std::abs(det) < min_shape * longest2);
+}
 
 // The invariants, or nothing when the points are degenerate (see wellSpread).
 std::optional<FivePointInvariants> fivePointInvariants(const std::array<cv::Point2d, 5>& p,
