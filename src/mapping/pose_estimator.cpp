@@ -464,8 +464,7 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
     FirstView& view = floor_views_[v];
     if (f.ok) {
       const bool same = view.floor_count > 0 &&
-                        std::acos(std::min(1.0, view.floor_down.dot(f.down))) * 180 / CV_PI <
-                            params_.floor.max_floor_change_deg;
+                        angleDeg(view.floor_down, f.down) < params_.floor.max_floor_change_deg;
       view.floor_count = same ? view.floor_count + 1 : 1;
       view.floor_down = f.down;
       if (!same) {

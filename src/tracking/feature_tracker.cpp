@@ -331,12 +331,7 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   std::vector<cv::Mat> descriptors;
   described_.clear();
   if (params_.reidentify) {
-    live_uv_.clear();
-    for (size_t i = 0; i < current_.size(); ++i) {
-      if (!in_band(current_[i].uv)) continue;
-      described_.push_back(static_cast<int>(i));
-      live_uv_.push_back(current_[i].uv);
-    }
+    selectInBand(in_band);
     for (const auto& p : fresh) live_uv_.push_back(p.uv);
     descriptors = orbDescriptors(gray, live_uv_);
     const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + described_.size(),
@@ -367,7 +362,7 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 // over the images, a share of the points on each, was measured: errors grew by up to
 // half on real textures and the search image's time hardly changed.)
 template <class InBand>
-void FeatureTracker::reanchor(const cv::Mat& gray, const InBand& in_band) {
+void FeatureTracker::selectInBand(const InBand& in_band) {
   described_.clear();
   live_uv_.clear();
   for (size_t i = 0; i < current_.size(); ++i) {
@@ -375,6 +370,11 @@ void FeatureTracker::reanchor(const cv::Mat& gray, const InBand& in_band) {
     described_.push_back(static_cast<int>(i));
     live_uv_.push_back(current_[i].uv);
   }
+}
+
+template <class InBand>
+void FeatureTracker::reanchor(const cv::Mat& gray, const InBand& in_band) {
+  selectInBand(in_band);
   if (live_uv_.empty()) return;
   std::vector<cv::Point2f>& refined = live_uv_;
   const int half = params_.reanchor_window_px;

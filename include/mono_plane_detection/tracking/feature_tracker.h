@@ -138,6 +138,9 @@ class FeatureTracker {
   void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part);
   template <class InBand>
   void reanchor(const cv::Mat& gray, const InBand& in_band);
+  // described_ and live_uv_: the live points in the band (indices into current_, positions).
+  template <class InBand>
+  void selectInBand(const InBand& in_band);
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
