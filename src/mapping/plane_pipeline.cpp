@@ -76,6 +76,7 @@ void PlanePipeline::reset() {
   if (pose_) pose_->reset();
   map_.reset();
   history_.clear();
+  stream_.reset();
   previous_planes_.clear();
 }
 
@@ -84,14 +85,18 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   PipelineResult result;
   if (!history_.empty()) {
     const double since = frame.stamp - history_.back().frame.stamp;
+    const auto since_ns = static_cast<int64_t>(std::llround(since * 1e9));
     if (since < 0) {  // a bag looping: the map of the old run does not apply
       reset();
       result.was_reset = true;
-    } else if (since > params_.max_gap_s) {
+    } else if (stream_.isPause(since_ns, params_.max_gap_s)) {
+      stream_.addPause(since_ns);
       history_.clear();
       previous_planes_.clear();
       if (pose_) pose_->forgetLastPose();
       result.tracking_loss = true;
+    } else {
+      stream_.add(since_ns);
     }
   }
 

@@ -46,31 +46,6 @@ std::string seconds(uint64_t ns) {
 
 }  // namespace
 
-long GapCounter::add(int64_t interval_ns) {
-  if (interval_ns <= 0) return 0;
-  recent_.push_back({interval_ns, 0});
-  while (recent_.size() > 64) recent_.pop_front();
-  if (recent_.size() < 4) return 0;
-  // The period: the second smallest recent interval (one short outlier does not set it).
-  // A consumer slower than the stream sees consecutive images only now and then (when
-  // its queue catches up), so earlier intervals are counted again against the newest
-  // period; what was counted before is never taken back.
-  std::vector<int64_t> sorted;
-  for (const auto& r : recent_) sorted.push_back(r.first);
-  std::nth_element(sorted.begin(), sorted.begin() + 1, sorted.end());
-  const double period = static_cast<double>(sorted[1]);
-  long added = 0;
-  for (auto& [interval, counted] : recent_) {
-    const double periods = static_cast<double>(interval) / period;
-    const long missing = periods > 1.5 ? std::lround(periods) - 1 : 0;
-    if (missing > counted) {
-      added += missing - counted;
-      counted = missing;
-    }
-  }
-  return added;
-}
-
 TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
     : params_(params), tracker_(params.tracker), target_startup_(params.target) {
   validate(params_);  // callers have reported the errors; never run on bad values
@@ -181,14 +156,15 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     gaps_.reset();
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
-    if (static_cast<double>(gap_ns) * 1e-9 > params_.max_gap_s) {
+    if (gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s)) {
       // After a pause the scene may have moved anywhere: Lucas-Kanade would follow the
-      // old points into the wrong places.
+      // old points into the wrong places. The stream's rhythm stays (a low-rate camera
+      // learns its period through its first pauses).
       out.warnings.push_back({"gap", seconds(gap_ns) + " s without images: tracking lost, "
                                                        "starting over"});
       tracker_.reset();
       target_startup_.reset();
-      gaps_.reset();
+      gaps_.addPause(static_cast<int64_t>(gap_ns));
     } else {
       counts_.missing += gaps_.add(static_cast<int64_t>(gap_ns));
     }

@@ -9,7 +9,6 @@
 #include <sensor_msgs/Image.h>
 
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +16,7 @@
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
+#include "mono_plane_detection/tracking/stream_gaps.h"
 #include "mono_plane_detection/params/param_table.h"
 #include "mono_plane_detection/tracking/target_startup.h"
 
@@ -44,25 +44,6 @@ struct TrackerCounts {
   long lost = 0;             // points lost, total
   long searches = 0;         // corner searches, total
   int tracked_now = 0;
-};
-
-// Counts images missing from a stream by its stamps: the stream's period is the second
-// smallest of the last 64 intervals (images that came in a row), and an interval of k
-// periods (rounded, above 1.5) means k - 1 images never reached us: our subscriber queue
-// dropped them, or the driver did. When the period estimate falls, the remembered
-// intervals are counted again (a saturated tracker sees images in a row only when its
-// queue catches up). Integer nanoseconds, so no stamp overflows. Chosen over header.seq
-// because publishers inside a nodelet manager need not fill seq, and roscpp does not
-// report what a subscriber queue drops. A stream that slows down for good counts as
-// missing images for up to 64 images.
-class GapCounter {
- public:
-  // Returns the number of images newly found missing.
-  long add(int64_t interval_ns);
-  void reset() { recent_.clear(); }
-
- private:
-  std::deque<std::pair<int64_t, long>> recent_;  // interval, images counted in it
 };
 
 class TrackerFrontEnd {

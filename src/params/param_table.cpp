@@ -355,7 +355,7 @@ const ParamTable<PipelineParams>& pipelineParamTable() {
         {"min_keyframe_shared", field(&P::min_keyframe_shared), 0, 1, "",
          "share of this image's tracks a reference must still hold"},
         {"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
-         "a longer pause between tracks messages is a tracking loss"},
+         "a longer pause between tracks messages (and over 3 of their periods) is a tracking loss"},
     };
     appendNested(t, "planes/", &P::planes, planeParamTable());
     appendNested(t, "pose/", &P::pose, poseParamTable());
@@ -377,7 +377,7 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
     t.push_back({"detect_target", field(&P::detect_target), 0, 1, "",
                  "look for the start-up target (paper II-A) until found"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
-                 "a longer pause between images is a tracking loss (start over)"});
+                 "a longer pause between images (and over 3 of their periods) is a tracking loss (start over)"});
     t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0.1, 1e6, "s",
                  "diagnostics WARN (with the reason) when images arrive this long without a "
                  "start-up target"});

@@ -104,6 +104,26 @@ TEST(PlanePipeline, TimeGoingBackwardsResetsAPauseIsATrackingLoss) {
   EXPECT_TRUE(pipeline.map().planes().empty());
 }
 
+// A 1 Hz stream (a low-rate bag): its one second between images is its rhythm, learnt
+// from the first pauses; a pause is then over 3 of its periods.
+TEST(PlanePipeline, LowRateStreamIsNotAPauseOnceItsPeriodIsKnown) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  std::vector<bool> lost;
+  double stamp = 100;
+  for (int k = 0; k < 10; ++k, stamp += 1.05) {
+    TrackFrame f = world.frame(k / 30.0);
+    f.stamp = stamp;
+    lost.push_back(pipeline.process(f).tracking_loss);
+  }
+  EXPECT_EQ(lost, std::vector<bool>({false, true, true, true, false, false, false, false,
+                                     false, false}));
+  TrackFrame f = world.frame(10 / 30.0);
+  f.stamp = stamp + 4.0;  // four periods later: a pause
+  EXPECT_TRUE(pipeline.process(f).tracking_loss);
+}
+
 TEST(PlanePipeline, CameraIntrinsicsAreChecked) {
   EXPECT_EQ(cameraIntrinsicsError(CameraModel().K(), cv::Mat()), "");
   EXPECT_NE(cameraIntrinsicsError(cv::Matx33d::zeros(), cv::Mat()), "");

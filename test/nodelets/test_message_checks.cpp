@@ -226,12 +226,30 @@ TEST(TrackerFrontEnd, ImagesMissingFromTheStreamAreCounted) {
   EXPECT_EQ(front.counts().dropped, 0);
 }
 
-TEST(GapCounter, RegularStreamHasNoGaps) {
-  GapCounter gaps;
-  long missing = 0;
-  for (int k = 0; k < 100; ++k) missing += gaps.add(33333333 + (k % 3) * 1000000);
-  EXPECT_EQ(missing, 0);
-  EXPECT_EQ(gaps.add(4 * 33333333), 3);
+// A 1 Hz camera (or bag): its first pauses restart tracking, then one second between
+// images is its rhythm and the tracks go on (ids kept); four seconds is a pause again.
+TEST(TrackerFrontEnd, LowRateStreamKeepsTrackingOnceItsPeriodIsKnown) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  std::vector<bool> gap;
+  Tracks::_id_type first_ids;
+  for (int k = 0; k < 8; ++k) {
+    const TrackerOutput out = front.process(image(grey, 100 + k, k * 20000000));
+    ASSERT_TRUE(out.tracks);
+    bool warned = false;
+    for (const LogEvent& e : out.warnings) warned |= e.kind == "gap";
+    gap.push_back(warned);
+    if (k == 4) first_ids = out.tracks->id;
+  }
+  EXPECT_EQ(gap, std::vector<bool>({false, true, true, true, false, false, false, false}));
+  const TrackerOutput last = front.process(image(grey, 108, 160000000));
+  ASSERT_TRUE(last.tracks);
+  EXPECT_EQ(last.tracks->id, first_ids);  // still the same tracks
+  const TrackerOutput paused = front.process(image(grey, 112, 160000000));
+  bool warned = false;
+  for (const LogEvent& e : paused.warnings) warned |= e.kind == "gap";
+  EXPECT_TRUE(warned);
+  EXPECT_EQ(front.counts().missing, 0);
 }
 
 // Issue 15, case 7: an infinite translation passed tf2; a 100 m jump was accepted.

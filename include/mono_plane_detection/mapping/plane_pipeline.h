@@ -13,6 +13,7 @@
 #include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/mapping/plane_map.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
+#include "mono_plane_detection/tracking/stream_gaps.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 #include "mono_plane_detection/tracking/track_frame.h"
 
@@ -26,7 +27,7 @@ struct PipelineParams {
   // Without intrinsics (or no image sharing enough tracks): compare with the image this
   // many images before.
   int frame_gap = 5;
-  double max_gap_s = 1.0;  // a longer pause between images is a tracking loss
+  double max_gap_s = 1.0;  // a longer pause (and over 3 stream periods) is a tracking loss
   // With intrinsics, the image to compare with (a keyframe) is chosen by its parallax:
   // the median image motion of the tracks that the best-fitting rotation between the two
   // images leaves (pixels at the focal length). Under rotation alone every plane moves
@@ -112,6 +113,7 @@ class PlanePipeline {
   std::vector<cv::Point2d> normalize(const std::vector<cv::Point2d>& pixels) const;
 
   std::deque<PastFrame> history_;
+  GapCounter stream_;  // the tracks' rhythm: what counts as a pause
   std::vector<ImagePlane> previous_planes_;
   int next_image_id_ = 1;
 };
