@@ -37,6 +37,23 @@ TrackFrame toTrackFrame(const Tracks& msg, std::string& error) {
   return frame;
 }
 
+std::string targetMismatch(const Tracks& msg, const TargetParams& own) {
+  if (msg.target_type.empty()) return {};
+  const auto corners = targetCornersInMap(own);
+  const double width = 2 * corners[2].x, height = 2 * corners[2].y;
+  const auto differs = [](double a, double b) { return std::abs(a - b) > 1e-4 * std::abs(b); };
+  if (msg.target_type == own.target_type && !differs(msg.target_width_m, width) &&
+      !differs(msg.target_height_m, height))
+    return {};
+  std::ostringstream why;
+  why << "the tracker's start-up target (" << msg.target_type << ", " << msg.target_width_m
+      << " x " << msg.target_height_m << " m) is not this nodelet's (" << own.target_type
+      << ", " << width << " x " << height
+      << " m): its corners are not used; set target/* once for both nodelets "
+         "(config/target.yaml, launch arg target_config)";
+  return why.str();
+}
+
 std::string odometryError(const Pose& odom, const std::optional<Pose>& previous,
                           double max_jump_m) {
   for (int i = 0; i < 9; ++i)

@@ -20,6 +20,11 @@ namespace mono_plane_detection {
 // The frame, or an error naming what is wrong (array lengths, values).
 TrackFrame toTrackFrame(const Tracks& msg, std::string& error);
 
+// Empty when the tracker's start-up target (as Tracks says: type and size) is the one
+// `own` describes, or when the message does not say; else both, for the user to fix.
+// Sizes agree within 1e-4 relative (Tracks carries float32).
+std::string targetMismatch(const Tracks& msg, const TargetParams& own);
+
 // Empty when an odometry pose can be used: finite, and no further than max_jump_m from
 // the previous one (when there is one); else why not.
 std::string odometryError(const Pose& odom_from_camera, const std::optional<Pose>& previous,

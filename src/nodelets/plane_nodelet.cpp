@@ -13,6 +13,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <algorithm>
 #include <deque>
 #include <fstream>
 #include <map>
@@ -382,6 +383,16 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
       last_tracks_size_ = frame.size;
+      // Corners of a target of another size than ours would fix a wrong scale (two
+      // nodelets configured apart): refused, loudly, until they agree.
+      if (std::find(frame.target_corner.begin(), frame.target_corner.end(), true) !=
+          frame.target_corner.end()) {
+        target_mismatch_ = targetMismatch(*msg, node_.pipeline.target);
+        if (!target_mismatch_.empty()) {
+          NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
+          frame.target_corner.assign(frame.target_corner.size(), false);
+        }
+      }
       if (!info_size_.empty() && info_size_ != frame.size)
         NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",
                               info_size_.width, info_size_.height, frame.size.width,
@@ -488,6 +499,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     const bool lost = state_ == PipelineState::kLost;
     if (!tf_conflict_.empty())
       status.summary(DiagnosticStatus::ERROR, "tf conflict: " + tf_conflict_);
+    else if (!target_mismatch_.empty())
+      status.summary(DiagnosticStatus::ERROR, "start-up target: " + target_mismatch_);
     else if (no_camera)  // the present state first, then what happened since the start
       status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
     else if (lost)
@@ -576,6 +589,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool odometry_stopped_ = false;  // metric_source odometry but none for the last image
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
+  std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)
   std::string tf_edge_;           // what is published
   std::set<std::string> published_edges_;  // links this nodelet has put on tf
 };

@@ -10,12 +10,17 @@ namespace mono_plane_detection {
 namespace {
 
 TracksPtr toMessage(const std_msgs::Header& header, const cv::Size& size,
-                    const std::vector<TrackedPoint>& points, bool searched) {
+                    const std::vector<TrackedPoint>& points, bool searched,
+                    const TargetParams& target) {
   TracksPtr msg(new Tracks);
   msg->header = header;
   msg->width = size.width;
   msg->height = size.height;
   msg->searched = searched;
+  msg->target_type = target.target_type;
+  const auto corners = targetCornersInMap(target);  // centred: corner 2 is (w/2, h/2)
+  msg->target_width_m = static_cast<float>(2 * corners[2].x);
+  msg->target_height_m = static_cast<float>(2 * corners[2].y);
   const size_t n = points.size();
   msg->id.reserve(n);
   msg->u.reserve(n);
@@ -210,7 +215,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   counts_.searches += stats.searched ? 1 : 0;
   counts_.lost += stats.lost;
   counts_.tracked_now = static_cast<int>(tracker_.current().size());
-  out.tracks = toMessage(msg->header, image.size(), tracker_.current(), stats.searched);
+  out.tracks = toMessage(msg->header, image.size(), tracker_.current(), stats.searched,
+                         params_.target);
   return out;
 }
 

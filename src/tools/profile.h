@@ -1,5 +1,5 @@
 // Profiles for the command-line tools: the nodelets' YAML files (config/tracker.yaml,
-// config/planes.yaml) with a robot's overlay on top (config/<nodelet>_<profile>.yaml),
+// config/planes.yaml, and config/target.yaml for both) with a robot's overlay on top (config/<nodelet>_<profile>.yaml),
 // read through the same parameter tables as the nodelets, so a tool runs with exactly
 // the settings `roslaunch ... profile:=humanoid` gives.
 #pragma once
@@ -55,7 +55,7 @@ std::vector<std::string> applyYamlFile(const std::string& path, const ParamTable
   return errors;
 }
 
-// config/<nodelet>.yaml, then config/<nodelet>_<profile>.yaml over it ("default": no
+// config/<nodelet>.yaml and config/target.yaml, then config/<nodelet>_<profile>.yaml over it ("default": no
 // overlay; "none": not even the base file, the core's defaults). A profile that is a path
 // to a .yaml file is read over the base file instead of an overlay.
 template <class P>
@@ -65,6 +65,11 @@ std::vector<std::string> loadProfile(const std::string& config_dir, const std::s
   if (profile == "none") return {};
   const bool is_file = profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
   std::vector<std::string> errors = applyYamlFile(config_dir + "/" + nodelet + ".yaml", table, params);
+  // The start-up target: one file for both nodelets, loaded by both launch files (a
+  // config folder without it: the defaults, which are what it holds as shipped).
+  const std::string target = config_dir + "/target.yaml";
+  if (std::ifstream(target))
+    for (std::string& e : applyYamlFile(target, table, params)) errors.push_back(std::move(e));
   if (profile == "default" || profile.empty()) return errors;
   const std::string overlay =
       is_file ? profile : config_dir + "/" + nodelet + "_" + profile + ".yaml";

@@ -252,6 +252,33 @@ TEST(TrackerFrontEnd, LowRateStreamKeepsTrackingOnceItsPeriodIsKnown) {
   EXPECT_EQ(front.counts().missing, 0);
 }
 
+// Two nodelets configured apart (a letter sheet set for the tracker only) would fix a
+// wrong scale: the plane nodelet names both targets; a recording without the fields, or
+// the same target, passes.
+TEST(PlaneMessages, TargetOfAnotherSizeIsNamed) {
+  TargetParams own;  // A4 sheet
+  Tracks msg;
+  EXPECT_EQ(targetMismatch(msg, own), "");  // not said (an older recording)
+  TrackerFrontEnd front;                    // what our tracker says: its own target/*
+  const TrackerOutput out = front.process(image(textured({320, 240}), 100));
+  ASSERT_TRUE(out.tracks);
+  EXPECT_EQ(out.tracks->target_type, "sheet");
+  EXPECT_EQ(targetMismatch(*out.tracks, own), "");
+  msg = *out.tracks;
+  msg.target_width_m = 0.2794f;  // US letter
+  msg.target_height_m = 0.2159f;
+  const std::string why = targetMismatch(msg, own);
+  EXPECT_NE(why.find("0.2794 x 0.2159"), std::string::npos) << why;
+  EXPECT_NE(why.find("0.297 x 0.21"), std::string::npos) << why;
+  EXPECT_NE(why.find("config/target.yaml"), std::string::npos) << why;
+  TargetParams marker;
+  marker.target_type = "aruco";
+  EXPECT_NE(targetMismatch(*out.tracks, marker), "");
+  msg.target_type = "aruco";
+  msg.target_width_m = msg.target_height_m = 0.15f;
+  EXPECT_EQ(targetMismatch(msg, marker), "");
+}
+
 // Issue 15, case 7: an infinite translation passed tf2; a 100 m jump was accepted.
 TEST(OdometryCheck, NonFiniteOrJumpingOdometryIsRefused) {
   Pose odom;

@@ -325,6 +325,40 @@ TEST_F(PlaneNodeletTest, F_TimeGoingBackwardsStartsTheMapOver) {
   EXPECT_TRUE(later->metric);
 }
 
+// Issue 12: the tracker says it looks for a US letter sheet, this nodelet has A4 (two
+// nodelets configured apart): the flagged corners would fix a wrong scale, so they are
+// not used and the diagnostics say why; the same target starts the map as in F.
+TEST_F(PlaneNodeletTest, F2_ATargetOfAnotherSizeDoesNotStartTheMap) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  const auto run = [&](float width_m, float height_m) {
+    PlaneArrayConstPtr last;
+    for (int k = 0; k < 63; ++k) {  // stamps back at 1000 s: the map starts over first
+      TracksPtr msg = toTracks(world_->frame(k / 30.0));
+      msg->target_type = "sheet";
+      msg->target_width_m = width_m;
+      msg->target_height_m = height_m;
+      last = send(msg);
+      if (!last) break;
+    }
+    return last;
+  };
+  const PlaneArrayConstPtr letter = run(0.2794f, 0.2159f);
+  ASSERT_TRUE(letter);
+  EXPECT_FALSE(letter->metric);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_NE(diagnostics.message().find("start-up target"), std::string::npos)
+      << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("0.2794 x 0.2159"), std::string::npos)
+      << diagnostics.message();
+  planes_.clear();  // the same stamps again: wait for the new answers
+  const PlaneArrayConstPtr a4 = run(0.297f, 0.21f);
+  ASSERT_TRUE(a4);
+  EXPECT_TRUE(a4->metric);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR);
+}
+
 TEST_F(PlaneNodeletTest, G_DebugImageWhileWatched) {
   sensor_msgs::ImageConstPtr drawn;
   ros::Subscriber debug = nh_.subscribe<sensor_msgs::Image>(

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <cerrno>
 #include <fstream>
 
 #include "support/temp_path.h"
@@ -78,6 +81,24 @@ TEST(Profile, HumanoidOverlayGivesAllItsKeys) {
                           planeNodeParamTable(), planes)
                   .empty());
   EXPECT_EQ(planes.pipeline.planes.groups.max_groups, 100);  // config/planes.yaml (core: 300)
+}
+
+// config/target.yaml is read by both nodelets' tools (as both launch files load it): a
+// US letter sheet set there reaches the tracker's detector and the plane nodelet's scale.
+TEST(Profile, TargetFileReachesBothNodelets) {
+  const std::string dir = tempPath("config");
+  ASSERT_EQ(::mkdir(dir.c_str(), 0700) == 0 || errno == EEXIST, true);
+  std::ofstream(dir + "/tracker.yaml") << "max_features: 60\n";
+  std::ofstream(dir + "/planes.yaml") << "frame_gap: 6\n";
+  std::ofstream(dir + "/target.yaml") << "target:\n  width_m: 0.2794\n  height_m: 0.2159\n";
+  TrackerNodeParams tracker;
+  EXPECT_TRUE(loadProfile(dir, "tracker", "default", trackerNodeParamTable(), tracker).empty());
+  EXPECT_DOUBLE_EQ(tracker.target.width_m, 0.2794);
+  EXPECT_DOUBLE_EQ(tracker.target.height_m, 0.2159);
+  PlaneNodeParams planes;
+  EXPECT_TRUE(loadProfile(dir, "planes", "default", planeNodeParamTable(), planes).empty());
+  EXPECT_DOUBLE_EQ(planes.pipeline.target.width_m, 0.2794);
+  EXPECT_EQ(planes.pipeline.frame_gap, 6);
 }
 
 TEST(Profile, NoneKeepsTheCoreDefaultsAndUnknownProfilesAreNamed) {
