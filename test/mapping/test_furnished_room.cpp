@@ -103,32 +103,36 @@ bool found(const RoomRun& run, const std::string& name) {
 
 }  // namespace
 
+// Figures on this commit (normal deg / distance m), wheeled: front wall 1.29 / 0.011, floor
+// 1.41 / 0.006, shelf front 1.46 / 0.003, left wall 1.22 / 0.072, camera 1.97 % of the path;
+// humanoid: front wall 0.67 / 0.000, shelf front 1.26 / 0.005, left wall 0.74 / 0.006, floor
+// 0.16 / 0.003, camera 0.43 %. Missed, and not mappable here (docs/mapping.md): the
+// sideboard front (wheeled: in view only before the metric start) and the back wall
+// (humanoid: plain paint, no corner on it).
 TEST(FurnishedRoom, WheeledPath) {
   const RoomRun run = runFurnished("wheeled");
   EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
-  for (const std::string name : {"front_wall", "floor", "shelf_+x"})
+  // The left wall: 18 points in 7 views, 0.1 m off, before the corners were spread over
+  // the image (TrackerParams::spread_cell_px); 53 points in 10 views since.
+  for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
-  // Known shortfall since the plane core estimates its noise scale (issue 13): the left
-  // wall's plane (13 of its 20 points on the wall) lies 0.1 m behind it, where the door
-  // recess is, and is matched to the door. It must be mapped as one of the two.
-  EXPECT_TRUE(found(run, "left_wall") || found(run, "door"));
-  EXPECT_LT(run.eval.worst_normal_error_deg, 5.0);
-  EXPECT_LT(run.eval.worst_distance_error_m, 0.15);
+  EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);  // the issue's bound
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.10);
   EXPECT_GE(run.posed, 250);
-  EXPECT_LT(run.worst_camera_m, 0.03 * run.travelled_m);
+  // Worst at the metric start (image 30: 0.05 m, the target seen face-on tilts the map
+  // 1.3-1.8 deg), not in the turn.
+  EXPECT_LT(run.worst_camera_m, 0.025 * run.travelled_m);
 }
 
 TEST(FurnishedRoom, HumanoidPath) {
   const RoomRun run = runFurnished("humanoid");
-  // The one plane that matched nothing (19 shelf-front points in a strip, 20 deg off) has
-  // normal_sigma_deg 1.08 against max_normal_sigma_deg 1.0: not confirmed.
   EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
   for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
-  EXPECT_LT(run.eval.worst_normal_error_deg, 5.0);
-  EXPECT_LT(run.eval.worst_distance_error_m, 0.15);
+  EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.02);
   EXPECT_GE(run.posed, 250);
-  EXPECT_LT(run.worst_camera_m, 0.01 * run.travelled_m);
+  EXPECT_LT(run.worst_camera_m, 0.007 * run.travelled_m);
 }
