@@ -52,6 +52,8 @@ void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Po
     if (corners.size() > keep) corners.resize(keep);
     return;
   }
+  // Cells under 8 px hold no two corners at any useful spacing (and would be millions).
+  cell_px = std::max(cell_px, 8.0);
   const int cols = std::max(1, static_cast<int>(std::ceil(image.width / cell_px)));
   const int rows = std::max(1, static_cast<int>(std::ceil(image.height / cell_px)));
   auto cell = [&](const cv::Point2f& p) {
@@ -59,25 +61,31 @@ void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Po
     const int cy = std::min(rows - 1, std::max(0, static_cast<int>(p.y / cell_px)));
     return cy * cols + cx;
   };
-  std::vector<int> count(static_cast<size_t>(cols * rows), 0);
+  const size_t cells = static_cast<size_t>(cols * rows);
+  std::vector<int> count(cells, 0);
   for (const auto& p : live) ++count[cell(p)];
-  // Per cell, its corners' indices, strongest first (the input order).
-  std::vector<std::vector<size_t>> queue(count.size());
-  for (size_t i = 0; i < corners.size(); ++i) queue[cell(corners[i])].push_back(i);
-  std::vector<size_t> next(count.size(), 0);
+  // The corners' indices grouped by cell (a counting sort keeps each cell's strongest
+  // first): cell c holds order[first[c] .. first[c + 1]). A few allocations per search.
+  std::vector<int> cell_of(corners.size());
+  std::vector<size_t> first(cells + 1, 0), order(corners.size());
+  for (size_t i = 0; i < corners.size(); ++i) ++first[(cell_of[i] = cell(corners[i])) + 1];
+  for (size_t c = 0; c < cells; ++c) first[c + 1] += first[c];
+  std::vector<size_t> next(first.begin(), first.end() - 1);
+  for (size_t i = 0; i < corners.size(); ++i) order[next[cell_of[i]]++] = i;
+  next.assign(first.begin(), first.end() - 1);
   std::vector<cv::Point2f> out;
   out.reserve(std::min(keep, corners.size()));
   while (out.size() < keep) {
     int best = -1;
-    for (size_t c = 0; c < queue.size(); ++c) {
-      if (next[c] >= queue[c].size()) continue;
+    for (size_t c = 0; c < cells; ++c) {
+      if (next[c] >= first[c + 1]) continue;
       // Fewest points first; among equals the cell whose next corner is the stronger.
       if (best < 0 || count[c] < count[best] ||
-          (count[c] == count[best] && queue[c][next[c]] < queue[best][next[best]]))
+          (count[c] == count[best] && order[next[c]] < order[next[best]]))
         best = static_cast<int>(c);
     }
     if (best < 0) break;
-    out.push_back(corners[queue[best][next[best]++]]);
+    out.push_back(corners[order[next[best]++]]);
     ++count[best];
   }
   corners = std::move(out);

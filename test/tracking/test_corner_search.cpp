@@ -283,3 +283,10 @@ TEST(CornerSearch, AWeaklyTexturedHalfGetsCornersWhenSpread) {
   EXPECT_GE(on_right(spread), 8);
   for (const auto& c : spread) EXPECT_LT(nearest(c, strong.corners), 0.3) << c;
 }
+
+TEST(CornerSearch, SpreadOverTinyCellsIsBounded) {
+  // A cell side far below a pixel is taken as 8 px: no grid of billions of cells.
+  std::vector<cv::Point2f> corners{{1, 1}, {2, 2}, {100, 100}};
+  spreadOverCells(corners, {}, {640, 480}, 1e-6, 3);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{1, 1}, {100, 100}, {2, 2}}));
+}
