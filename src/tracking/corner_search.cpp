@@ -46,6 +46,51 @@ int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>&
   return static_cast<int>(before - kept);
 }
 
+void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
+                     const cv::Size& image, double cell_px, size_t keep) {
+  if (cell_px <= 0 || image.empty()) {
+    if (corners.size() > keep) corners.resize(keep);
+    return;
+  }
+  // Cells under 8 px hold no two corners at any useful spacing (and would be millions).
+  cell_px = std::max(cell_px, 8.0);
+  const int cols = std::max(1, static_cast<int>(std::ceil(image.width / cell_px)));
+  const int rows = std::max(1, static_cast<int>(std::ceil(image.height / cell_px)));
+  auto cell = [&](const cv::Point2f& p) {
+    const int cx = std::min(cols - 1, std::max(0, static_cast<int>(p.x / cell_px)));
+    const int cy = std::min(rows - 1, std::max(0, static_cast<int>(p.y / cell_px)));
+    return cy * cols + cx;
+  };
+  const size_t cells = static_cast<size_t>(cols * rows);
+  std::vector<int> count(cells, 0);
+  for (const auto& p : live) ++count[cell(p)];
+  // The corners' indices grouped by cell (a counting sort keeps each cell's strongest
+  // first): cell c holds order[first[c] .. first[c + 1]). A few allocations per search.
+  std::vector<int> cell_of(corners.size());
+  std::vector<size_t> first(cells + 1, 0), order(corners.size());
+  for (size_t i = 0; i < corners.size(); ++i) ++first[(cell_of[i] = cell(corners[i])) + 1];
+  for (size_t c = 0; c < cells; ++c) first[c + 1] += first[c];
+  std::vector<size_t> next(first.begin(), first.end() - 1);
+  for (size_t i = 0; i < corners.size(); ++i) order[next[cell_of[i]]++] = i;
+  next.assign(first.begin(), first.end() - 1);
+  std::vector<cv::Point2f> out;
+  out.reserve(std::min(keep, corners.size()));
+  while (out.size() < keep) {
+    int best = -1;
+    for (size_t c = 0; c < cells; ++c) {
+      if (next[c] >= first[c + 1]) continue;
+      // Fewest points first; among equals the cell whose next corner is the stronger.
+      if (best < 0 || count[c] < count[best] ||
+          (count[c] == count[best] && order[next[c]] < order[next[best]]))
+        best = static_cast<int>(c);
+    }
+    if (best < 0) break;
+    out.push_back(corners[order[next[best]++]]);
+    ++count[best];
+  }
+  corners = std::move(out);
+}
+
 const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,
@@ -79,13 +124,18 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   // search finds the same corners again (paper II-D keeps ids by finding them again).
   const bool rank = level > 0 && derivatives != nullptr;
   const int ask = rank ? 3 * wanted + 8 : wanted;
+  // Spread over cells: the candidates come from the whole image (every corner above the
+  // quality bar, up to 4 x max_features), then `ask` of them spread over the cells.
+  const bool spread = params.spread_cell_px > 0;
+  const int pool = spread ? std::max(ask, 4 * params.max_features) : ask;
   // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
   // the scores at the band's edge are those of the whole image.)
-  cv::goodFeaturesToTrack(level_image(on_level), corners, ask, params.quality_level, min_distance,
+  cv::goodFeaturesToTrack(level_image(on_level), corners, pool, params.quality_level, min_distance,
                           mask.empty() ? mask : mask(on_level), params.block_size);
   if (corners.empty()) return corners;
   const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
   for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
+  if (spread) spreadOverCells(corners, live, full.size(), params.spread_cell_px, ask);
   // Score: the best of the pixel nearest the corner and its 8 neighbours (a corner found
   // by goodFeaturesToTrack is its neighbourhood's maximum).
   auto score = [&](const cv::Point2f& c, int block) {
@@ -131,6 +181,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                                  }),
                   corners.end());
   }
+  // Ranked by score again above: spread again before the first `wanted` are kept.
+  if (spread) spreadOverCells(corners, live, full.size(), params.spread_cell_px, corners.size());
   keepApart(corners, live, params.min_distance_px, wanted);
   if (rank && static_cast<int>(corners.size()) < wanted) {
     // The coarse level holds fewer corners than wanted (fine texture fades there): the

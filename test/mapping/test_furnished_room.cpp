@@ -24,7 +24,9 @@ struct RoomRun {
   int posed = 0;
 };
 
-RoomRun runFurnished(const std::string& path) {
+// odometry: the true camera poses as tf odom -> camera (metric_source odometry), the map
+// from the first image on and in the world frame; judged in the target's frame.
+RoomRun runFurnished(const std::string& path, bool odometry = false) {
   RoomParams room;
   room.layout = "furnished";
   room.photos = loadTexturePhotos(std::string(TEST_DATA_DIR) + "/textures");
@@ -43,7 +45,9 @@ RoomRun runFurnished(const std::string& path) {
   }
   FeatureTracker tracker(tracker_params);
   TargetStartup startup;
-  PlanePipeline pipeline;
+  PipelineParams params;
+  if (odometry) params.pose.metric_source = "odometry";
+  PlanePipeline pipeline(params);
   pipeline.setCamera(camera.K(), camera.distortion());
   RoomRun run;
   run.truth = truthPlanes(scene);
@@ -58,8 +62,9 @@ RoomRun runFurnished(const std::string& path) {
     tracker.process(image);
     startup.process(image, tracker);
     const TrackFrame frame = trackFrameOf(tracker.current(), 1000.0 + k / 30.0, image.size());
-    const PipelineResult result = pipeline.process(frame);
-    const Pose truth = map_from_world * world_from_camera;
+    const PipelineResult result =
+        odometry ? pipeline.process(frame, world_from_camera) : pipeline.process(frame);
+    const Pose truth = odometry ? world_from_camera : map_from_world * world_from_camera;
     if (k > 0) run.travelled_m += cv::norm(truth.t - last);
     last = truth.t;
     if (result.pose) {
@@ -71,10 +76,16 @@ RoomRun runFurnished(const std::string& path) {
   std::vector<MapPlane> confirmed;
   for (const MapPlane& p : pipeline.map().planes())
     if (p.confirmed(pipeline.map().params())) confirmed.push_back(p);
+  if (odometry)
+    for (MapPlane& p : confirmed) {  // world -> the target's frame, as the truth
+      p.normal = map_from_world.R * p.normal;
+      p.distance += p.normal.dot(map_from_world.t);
+      for (cv::Vec3d& v : p.polygon) v = map_from_world.apply(v);
+    }
   run.eval = evaluateMap(confirmed, run.truth, 0.10, 20.0, 0.3);
-  std::printf("%s: camera worst %.3f m over %.2f m (%.1f %%), placed in %d images\n", path.c_str(),
-              run.worst_camera_m, run.travelled_m, 100 * run.worst_camera_m / run.travelled_m,
-              run.posed);
+  std::printf("%s%s: camera worst %.3f m over %.2f m (%.1f %%), placed in %d images\n",
+              path.c_str(), odometry ? " (odometry)" : "", run.worst_camera_m, run.travelled_m,
+              100 * run.worst_camera_m / run.travelled_m, run.posed);
   for (size_t i = 0; i < confirmed.size(); ++i)
     std::printf("  plane %d (%zu points, %d views) -> %s: normal %.2f deg, distance %.3f m\n",
                 confirmed[i].id, confirmed[i].points.size(), confirmed[i].observations,
@@ -103,32 +114,51 @@ bool found(const RoomRun& run, const std::string& name) {
 
 }  // namespace
 
+// Figures on this commit (normal deg / distance m), wheeled: front wall 1.29 / 0.011, floor
+// 1.41 / 0.006, shelf front 1.46 / 0.003, left wall 1.22 / 0.072, camera 1.97 % of the path;
+// humanoid: front wall 0.67 / 0.000, shelf front 1.26 / 0.005, left wall 0.74 / 0.006, floor
+// 0.16 / 0.003, camera 0.43 %. Missed, and not mappable here (docs/mapping.md): the
+// sideboard front (wheeled: in view only before the metric start) and the back wall
+// (humanoid: plain paint, no corner on it).
 TEST(FurnishedRoom, WheeledPath) {
   const RoomRun run = runFurnished("wheeled");
   EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
-  for (const std::string name : {"front_wall", "floor", "shelf_+x"})
+  // The left wall: 18 points in 7 views, 0.1 m off, before the corners were spread over
+  // the image (TrackerParams::spread_cell_px); 53 points in 10 views since.
+  for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
-  // Known shortfall since the plane core estimates its noise scale (issue 13): the left
-  // wall's plane (13 of its 20 points on the wall) lies 0.1 m behind it, where the door
-  // recess is, and is matched to the door. It must be mapped as one of the two.
-  EXPECT_TRUE(found(run, "left_wall") || found(run, "door"));
-  EXPECT_LT(run.eval.worst_normal_error_deg, 5.0);
-  EXPECT_LT(run.eval.worst_distance_error_m, 0.15);
+  EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);  // the issue's bound
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.10);
   EXPECT_GE(run.posed, 250);
-  EXPECT_LT(run.worst_camera_m, 0.03 * run.travelled_m);
+  // Worst at the metric start (image 30: 0.05 m, the target seen face-on tilts the map
+  // 1.3-1.8 deg), not in the turn.
+  EXPECT_LT(run.worst_camera_m, 0.025 * run.travelled_m);
 }
 
 TEST(FurnishedRoom, HumanoidPath) {
   const RoomRun run = runFurnished("humanoid");
-  // The one plane that matched nothing (19 shelf-front points in a strip, 20 deg off) has
-  // normal_sigma_deg 1.08 against max_normal_sigma_deg 1.0: not confirmed.
   EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
   for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
-  EXPECT_LT(run.eval.worst_normal_error_deg, 5.0);
-  EXPECT_LT(run.eval.worst_distance_error_m, 0.15);
+  EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.02);
   EXPECT_GE(run.posed, 250);
-  EXPECT_LT(run.worst_camera_m, 0.01 * run.travelled_m);
+  EXPECT_LT(run.worst_camera_m, 0.007 * run.travelled_m);
+}
+
+// The same wheeled path with the map from the first image (odometry): the planes without
+// the target start's tilt (normals within 0.5 deg instead of 1.2-1.5). The sideboard front
+// is still missed: its tracks reach the 3 deg triangulation parallax only from image 17,
+// when 6-8 are left and the image-space vote no longer separates them.
+TEST(FurnishedRoom, WheeledPathWithOdometry) {
+  const RoomRun run = runFurnished("wheeled", true);
+  EXPECT_EQ(falsePlanes(run.eval), 0);
+  EXPECT_TRUE(run.eval.split.empty());
+  for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
+    EXPECT_TRUE(found(run, name)) << name;
+  EXPECT_LT(run.eval.worst_normal_error_deg, 0.8);
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.02);
+  EXPECT_EQ(run.posed, 300);
 }

@@ -238,3 +238,55 @@ TEST(CornerSearch, BandsOfRowsTogetherFindWhatTheWholeImageHolds) {
                           cv::Rect(0, 600, 640, 100))
                   .empty());
 }
+
+TEST(CornerSearch, SpreadOverCellsServesTheCellWithFewestPointsFirst) {
+  // Strongest first: three corners in the cell at the origin, then two in the next one.
+  const std::vector<cv::Point2f> input{{10, 10}, {30, 10}, {50, 10}, {110, 10}, {130, 10}};
+  std::vector<cv::Point2f> corners = input;
+  spreadOverCells(corners, {}, {200, 100}, 100, 4);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{10, 10}, {110, 10}, {30, 10}, {130, 10}}));
+  // Live points count: the second cell holds two already, so the first gives two first.
+  corners = input;
+  spreadOverCells(corners, {{150, 50}, {160, 60}}, {200, 100}, 100, 3);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{10, 10}, {30, 10}, {50, 10}}));
+  // Fewer corners than wanted: all of them, spread.
+  corners = input;
+  spreadOverCells(corners, {}, {200, 100}, 100, 50);
+  EXPECT_EQ(corners.size(), input.size());
+  // cell_px 0: strongest first, only truncated.
+  corners = input;
+  spreadOverCells(corners, {}, {200, 100}, 0, 2);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{10, 10}, {30, 10}}));
+}
+
+TEST(CornerSearch, AWeaklyTexturedHalfGetsCornersWhenSpread) {
+  // Left half: strong squares; right half: faint ones (contrast 40 instead of 160, score
+  // 6 % of the strong ones: above the 1 % quality bar).
+  const Squares strong = squares({640, 240});
+  cv::Mat image = strong.image.clone();
+  cv::Mat right = image(cv::Rect(320, 0, 320, 240));
+  right.convertTo(right, CV_8U, 0.25, 30);
+  int levels = 0;
+  const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+  TrackerParams params;
+  CornerSearchBuffers buffers;
+  auto on_right = [](const std::vector<cv::Point2f>& corners) {
+    return std::count_if(corners.begin(), corners.end(),
+                         [](const cv::Point2f& c) { return c.x > 320; });
+  };
+  params.spread_cell_px = 0;  // strongest first: every corner on the strong half
+  EXPECT_EQ(on_right(findCorners(image, pyramid[2], 1, {}, 20, params, buffers, &pyramid[1])), 0);
+  params.spread_cell_px = 80;
+  const std::vector<cv::Point2f> spread =
+      findCorners(image, pyramid[2], 1, {}, 20, params, buffers, &pyramid[1]);
+  EXPECT_EQ(spread.size(), 20u);
+  EXPECT_GE(on_right(spread), 8);
+  for (const auto& c : spread) EXPECT_LT(nearest(c, strong.corners), 0.3) << c;
+}
+
+TEST(CornerSearch, SpreadOverTinyCellsIsBounded) {
+  // A cell side far below a pixel is taken as 8 px: no grid of billions of cells.
+  std::vector<cv::Point2f> corners{{1, 1}, {2, 2}, {100, 100}};
+  spreadOverCells(corners, {}, {640, 480}, 1e-6, 3);
+  EXPECT_EQ(corners, (std::vector<cv::Point2f>{{1, 1}, {100, 100}, {2, 2}}));
+}

@@ -24,6 +24,14 @@ int cornerSearchLevel(const cv::Size& image, int levels_built, const TrackerPara
 int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
               double min_distance_px, int wanted);
 
+// Keeps at most `keep` of `corners` (strongest first), taking each next one from the
+// cell of a grid of cell_px squares over `image` that holds the fewest points so far
+// (live points and corners taken), the strongest there first: a weakly textured surface
+// next to a richly textured one still gets corners (strongest-first alone spends every
+// corner on the rich one). cell_px <= 0: the first `keep`, unchanged; cells are at least 8 px.
+void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
+                     const cv::Size& image, double cell_px, size_t keep);
+
 // Buffers kept across searches so that a search allocates nothing they can hold.
 struct CornerSearchBuffers {
   cv::Mat mask;
