@@ -25,12 +25,12 @@ namespace {
 struct Motion {
   cv::Matx33d R;
   cv::Vec3d t;
-  double sigma = 0;      // the tracks' measured noise (normalised units)
-  double threshold = 0;  // RANSAC threshold used (normalised units)
-  std::vector<int> index;           // tracks triangulated in front of both views
-  std::vector<cv::Vec3d> points;    // their points
-  std::vector<double> parallax_of;  // their parallax, deg
-  std::vector<double> all_parallax; // every inlier's parallax, deg
+  double sigma = 0;                  // the tracks' measured noise (normalised units)
+  double threshold = 0;              // RANSAC threshold used (normalised units)
+  std::vector<int> index;            // tracks triangulated in front of both views
+  std::vector<cv::Vec3d> points;     // their points
+  std::vector<double> parallax_of;   // their parallax, deg
+  std::vector<double> all_parallax;  // every inlier's parallax, deg
 };
 
 // The motion's direction from every track (essential matrix): a strip of floor alone
@@ -144,7 +144,8 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     out.reason = "too few tracks";
     return out;
   }
-  std::optional<Motion> motion = measureMotion(first, second, focal_px, params.max_error_px, out.reason);
+  std::optional<Motion> motion =
+      measureMotion(first, second, focal_px, params.max_error_px, out.reason);
   if (!motion) return out;
   const cv::Matx33d R = motion->R;
   const cv::Vec3d t = motion->t;

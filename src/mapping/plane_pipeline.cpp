@@ -148,7 +148,8 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       map_.update(observationsOf(v.planes, v.pose), v.stamp);
     }
     pending_.clear();
-    const std::vector<int> map_ids = map_.update(observationsOf(result.planes, *result.pose), frame.stamp);
+    const std::vector<int> map_ids =
+        map_.update(observationsOf(result.planes, *result.pose), frame.stamp);
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
 
@@ -184,7 +185,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
 }
 
 std::vector<PlaneObservation> PlanePipeline::observationsOf(const std::vector<ImagePlane>& planes,
-                                                           const PoseEstimate& pose) const {
+                                                            const PoseEstimate& pose) const {
   std::vector<PlaneObservation> observations;
   // A landmark's position along its ray is uncertain by about depth x (angular noise)
   // / parallax: the angular noise from this pose's reprojection error (both rays).

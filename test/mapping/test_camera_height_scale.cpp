@@ -242,8 +242,8 @@ TEST(CameraHeightScale, FloorFittedToAMapOfUnknownScale) {
   for (cv::Vec3d& x : m.points) x *= k;
   for (cv::Vec3d& c : m.cameras) c *= k;
   for (double& s : m.sigma) s *= k;
-  const FloorFit fit =
-      fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 25, 0.03, 30, 0.01, true);
+  const FloorFit fit = fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 25,
+                                           0.03, 30, 0.01, true);
   ASSERT_TRUE(fit.ok) << fit.reason;
   EXPECT_LT(angleDeg(fit.up, m.up), 0.3);
   EXPECT_NEAR(fit.offset, k * m.offset, 0.03);
@@ -256,8 +256,9 @@ TEST(CameraHeightScale, FloorFittedToAMapOfUnknownScale) {
   for (const cv::Vec3d& c : m.cameras) EXPECT_NEAR(s.apply(c)[1], 0.8, 0.01);
   // Absolute tolerances (the scaled start's) on this map: the floor's gate is three
   // times too narrow for its noise and the 6 deg cone misses it.
-  EXPECT_FALSE(
-      fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30, 0.008).ok);
+  EXPECT_FALSE(fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30,
+                                   0.008)
+                   .ok);
 }
 
 TEST(CameraHeightScale, TheCamerasPathFixesTheStripsTilt) {

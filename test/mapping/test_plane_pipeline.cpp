@@ -31,7 +31,9 @@ TEST(PlanePipeline, MapsTheRoomsPlanesInMetres) {
   for (int k = 0; k < frames; ++k) {
     const PipelineResult r = pipeline.process(world.frame(k / 30.0));
     tracking += r.state == PipelineState::kTracking;
-    if (k > 10) EXPECT_FALSE(r.planes.empty()) << "frame " << k;
+    if (k > 10) {
+      EXPECT_FALSE(r.planes.empty()) << "frame " << k;
+    }
   }
   EXPECT_GE(tracking, frames - 40);  // all but the start (about 1 s of motion)
   std::vector<MapPlane> confirmed;
