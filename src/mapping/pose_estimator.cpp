@@ -204,6 +204,10 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   FloorCheck& check = *floor_check_;
   const FloorParams& p = params_.floor;
   check.cameras.push_back(estimate.map_from_camera.t);
+  // An up-to-scale start waits for its floor without a time limit: the path kept for the
+  // fit is bounded as the plane pipeline's waiting images (1000), the first one kept
+  // (the map's origin lies below it).
+  if (check.cameras.size() > 1000) check.cameras.erase(check.cameras.begin() + 1);
   // Motion in the start's units (near metres): the floor landmarks need views apart.
   double moved = 0;
   for (const cv::Vec3d& c : check.cameras)
