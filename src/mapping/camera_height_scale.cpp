@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <optional>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/plane_fit.h"
 #include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
@@ -13,8 +15,118 @@ namespace {
 
 cv::Vec3d ray(const cv::Point2d& n) { return cv::Vec3d(n.x, n.y, 1.0); }
 cv::Vec3d unit(const cv::Vec3d& v) { return v / cv::norm(v); }
-double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
-  return std::acos(std::max(-1.0, std::min(1.0, unit(a).dot(unit(b))))) * 180.0 / CV_PI;
+
+}  // namespace
+
+namespace {
+
+// The motion between two views from every track, its length 1, and every inlier track
+// triangulated with it (first camera frame).
+struct Motion {
+  cv::Matx33d R;
+  cv::Vec3d t;
+  double sigma = 0;                  // the tracks' measured noise (normalised units)
+  double threshold = 0;              // RANSAC threshold used (normalised units)
+  std::vector<int> index;            // tracks triangulated in front of both views
+  std::vector<cv::Vec3d> points;     // their points
+  std::vector<double> parallax_of;   // their parallax, deg
+  std::vector<double> all_parallax;  // every inlier's parallax, deg
+};
+
+// The motion's direction from every track (essential matrix): a strip of floor alone
+// fixes it poorly. The tracks' noise is measured, not assumed: a first RANSAC at the
+// largest threshold, its inliers' median Sampson error gives sigma, the second uses
+// 3 sigma (never above max_error_px). Empty (and `reason`) when there is no motion.
+std::optional<Motion> measureMotion(const std::vector<cv::Point2d>& first,
+                                    const std::vector<cv::Point2d>& second, double focal_px,
+                                    double max_error_px, std::string& reason,
+                                    bool select_plane = false) {
+  const int n = static_cast<int>(first.size());
+  std::vector<uchar> mask;
+  cv::Mat Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999,
+                                    max_error_px / focal_px, mask);
+  if (Em.rows != 3 || Em.cols != 3) {
+    reason = "no motion between the views (essential matrix)";
+    return std::nullopt;
+  }
+  Motion m;
+  std::vector<double> residuals;
+  for (int i = 0; i < n; ++i)
+    if (mask[i]) residuals.push_back(sampsonDistance(cv::Matx33d(Em), first[i], second[i]));
+  m.sigma = std::max(1.4826 * median(residuals), 0.05 / focal_px);
+  m.threshold = std::min(3 * m.sigma, max_error_px / focal_px);
+  Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, m.threshold,
+                            mask);
+  if (Em.rows != 3 || Em.cols != 3) {
+    reason = "no motion between the views (essential matrix)";
+    return std::nullopt;
+  }
+  const int essential_inliers = cv::countNonZero(mask);
+  cv::Mat Rm, tm;
+  cv::recoverPose(Em, first, second, Rm, tm, 1.0, cv::Point2d(0, 0), mask);
+  m.R = cv::Matx33d(Rm);
+  m.t = unit(cv::Vec3d(tm));
+  if (select_plane) {
+    // A view filled by one plane (a wall ahead) leaves the essential matrix poorly
+    // determined: the motion then comes from that plane's homography (model selection
+    // as ORB-SLAM's initialisation: the homography when it explains the tracks about as
+    // well, its inliers over both counts above 0.45). Of its decompositions, the one
+    // whose epipolar geometry the most tracks agree with (those off the plane decide).
+    std::vector<uchar> on_plane;
+    const cv::Mat Hm = cv::findHomography(first, second, cv::RANSAC, m.threshold, on_plane);
+    const int homography_inliers = Hm.empty() ? 0 : cv::countNonZero(on_plane);
+    if (homography_inliers > 0.45 * (homography_inliers + essential_inliers)) {
+      std::vector<cv::Mat> Rs, ts, normals;
+      cv::decomposeHomographyMat(Hm, cv::Mat::eye(3, 3, CV_64F), Rs, ts, normals);
+      const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
+      int best = -1;
+      std::vector<uchar> best_mask;
+      for (size_t c = 0; c < Rs.size(); ++c) {
+        const cv::Matx33d R(Rs[c]);
+        const cv::Vec3d t(ts[c]);
+        if (!(cv::norm(t) > 0)) continue;
+        const cv::Vec3d tu = unit(t);
+        const cv::Matx33d tx(0, -tu[2], tu[1], tu[2], 0, -tu[0], -tu[1], tu[0], 0);
+        const cv::Matx33d E = tx * R;
+        const cv::Matx34d P2 = projectionMatrix(R, tu);
+        std::vector<uchar> agree(n, 0);
+        int count = 0;
+        for (int i = 0; i < n; ++i) {
+          if (sampsonDistance(E, first[i], second[i]) > m.threshold) continue;
+          const auto p = triangulate(P1, P2, first[i], second[i]);
+          if (!p || p->depth1 <= 0 || p->depth2 <= 0) continue;
+          agree[i] = 1;
+          ++count;
+        }
+        if (count > best) {
+          best = count;
+          best_mask = agree;
+          m.R = R;
+          m.t = tu;
+        }
+      }
+      if (best > 0) mask = best_mask;
+    }
+  }
+  // Each inlier's parallax (rotation removed) and its point, the motion's length 1.
+  const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
+  const cv::Matx34d P2 = projectionMatrix(m.R, m.t);
+  for (int i = 0; i < n; ++i) {
+    if (!mask[i]) continue;
+    const double parallax = normalAngleDeg(ray(first[i]), m.R.t() * ray(second[i]));
+    m.all_parallax.push_back(parallax);
+    const auto p = triangulate(P1, P2, first[i], second[i]);
+    if (!p || p->depth1 <= 0 || p->depth2 <= 0) continue;
+    m.index.push_back(i);
+    m.points.push_back(p->x);
+    m.parallax_of.push_back(parallax);
+  }
+  return m;
+}
+
+cv::Vec3d nominalDown(const FloorParams& params) {
+  const double pitch = params.pitch_down_deg * CV_PI / 180.0;
+  return cv::Vec3d(0, std::cos(pitch), std::sin(pitch));  // x right, y down, z ahead
 }
 
 }  // namespace
@@ -32,49 +144,17 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     out.reason = "too few tracks";
     return out;
   }
-  // The motion's direction from every track (essential matrix): a strip of floor alone
-  // fixes it poorly. The tracks' noise is measured, not assumed: a first RANSAC at the
-  // largest threshold, its inliers' median Sampson error gives sigma, the second uses
-  // 3 sigma (never above max_error_px).
-  std::vector<uchar> mask;
-  cv::Mat Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999,
-                                    params.max_error_px / focal_px, mask);
-  if (Em.rows != 3 || Em.cols != 3) {
-    out.reason = "no motion between the views (essential matrix)";
-    return out;
-  }
-  std::vector<double> residuals;
-  for (int i = 0; i < n; ++i)
-    if (mask[i]) residuals.push_back(sampsonDistance(cv::Matx33d(Em), first[i], second[i]));
-  const double sigma = std::max(1.4826 * median(residuals), 0.05 / focal_px);
-  const double threshold = std::min(3 * sigma, params.max_error_px / focal_px);
+  std::optional<Motion> motion =
+      measureMotion(first, second, focal_px, params.max_error_px, out.reason);
+  if (!motion) return out;
+  const cv::Matx33d R = motion->R;
+  const cv::Vec3d t = motion->t;
+  const double sigma = motion->sigma, threshold = motion->threshold;
   out.noise_px = sigma * focal_px;
-  Em = cv::findEssentialMat(first, second, 1.0, cv::Point2d(0, 0), cv::RANSAC, 0.999, threshold,
-                            mask);
-  if (Em.rows != 3 || Em.cols != 3) {
-    out.reason = "no motion between the views (essential matrix)";
-    return out;
-  }
-  cv::Mat Rm, tm;
-  cv::recoverPose(Em, first, second, Rm, tm, 1.0, cv::Point2d(0, 0), mask);
-  const cv::Matx33d R(Rm);
-  const cv::Vec3d t = unit(cv::Vec3d(tm));
-  // Each inlier's parallax (rotation removed) and its point, the motion's length 1.
-  const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
-  const cv::Matx34d P2 = projectionMatrix(R, t);
-  std::vector<int> index;
-  std::vector<cv::Vec3d> points;
-  std::vector<double> parallax_of, all_parallax;
-  for (int i = 0; i < n; ++i) {
-    if (!mask[i]) continue;
-    const double parallax = angleDeg(ray(first[i]), R.t() * ray(second[i]));
-    all_parallax.push_back(parallax);
-    const auto p = triangulate(P1, P2, first[i], second[i]);
-    if (!p || p->depth1 <= 0 || p->depth2 <= 0) continue;
-    index.push_back(i);
-    points.push_back(p->x);
-    parallax_of.push_back(parallax);
-  }
+  const std::vector<int>& index = motion->index;
+  const std::vector<cv::Vec3d>& points = motion->points;
+  const std::vector<double>& parallax_of = motion->parallax_of;
+  const std::vector<double>& all_parallax = motion->all_parallax;
   if (all_parallax.empty() || median(all_parallax) < 0.25 * params.min_parallax_deg) {
     out.reason = "not enough motion yet (parallax)";
     return out;
@@ -86,8 +166,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
   // The floor: of the planes through three triangulated points whose normal is within
   // max_floor_angle_deg of the nominal down, the one whose homography (H = R + t n^T / d)
   // carries the most tracks within the noise threshold.
-  const double pitch = params.pitch_down_deg * CV_PI / 180.0;
-  const cv::Vec3d nominal_down(0, std::cos(pitch), std::sin(pitch));  // x right, y down, z ahead
+  const cv::Vec3d nominal_down = nominalDown(params);
   cv::RNG rng(1);  // repeatable
   std::vector<int> best;
   int best_telling = 0;
@@ -125,7 +204,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
       normal = -normal;
       d = -d;
     }
-    if (!(d > 0) || angleDeg(normal, nominal_down) > params.max_floor_angle_deg) continue;
+    if (!(d > 0) || normalAngleDeg(normal, nominal_down) > params.max_floor_angle_deg) continue;
     const cv::Matx33d H = R + t * (normal / d).t();
     std::vector<int> inliers;
     int telling = 0;
@@ -185,7 +264,7 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
   for (int k : best) floor_parallax.push_back(parallax_of[k]);
   const double d = cv::norm(m_plane) > 0 ? 1.0 / cv::norm(m_plane) : 0;  // in lengths of the motion
   const cv::Vec3d normal = m_plane * d;
-  if (!(d > 0) || angleDeg(normal, nominal_down) > params.max_floor_angle_deg) {
+  if (!(d > 0) || normalAngleDeg(normal, nominal_down) > params.max_floor_angle_deg) {
     out.reason = "no plane near the nominal floor";
     return out;
   }
@@ -203,6 +282,57 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
     out.ok = false;
     out.reason = "floor found, not enough motion yet (parallax)";
   }
+  return out;
+}
+
+FloorStart unscaledStart(const std::vector<cv::Point2d>& first,
+                         const std::vector<cv::Point2d>& second, double focal_px,
+                         const FloorParams& params) {
+  FloorStart out;
+  if (!(params.camera_height_m > 0)) {
+    out.reason = "camera height unknown";
+    return out;
+  }
+  const int n = static_cast<int>(first.size());
+  const int needed = std::max(8, params.min_check_points);
+  if (static_cast<int>(second.size()) != n || n < needed) {
+    out.reason = "too few tracks";
+    return out;
+  }
+  std::optional<Motion> motion =
+      measureMotion(first, second, focal_px, params.max_error_px, out.reason, true);
+  if (!motion) return out;
+  out.noise_px = motion->sigma * focal_px;
+  // The map is built from these points: their own parallax, not the far tracks', must
+  // reach what the floor start asks of the floor's tracks.
+  if (motion->parallax_of.empty() || median(motion->parallax_of) < params.min_parallax_deg) {
+    out.reason = "not enough motion yet (parallax)";
+    return out;
+  }
+  if (static_cast<int>(motion->points.size()) < needed) {
+    out.reason = "too few tracks triangulate";
+    return out;
+  }
+  // A first guess of the scale, corrected by the floor landmarks later: the floor is the
+  // lowest surface, so the lowest tracks (below the nominal horizon, a high percentile of
+  // their depth below the camera) are taken to lie camera_height_m down. When no floor is
+  // in view they lie higher and the guess is too large; the check does not bound it.
+  const cv::Vec3d down = nominalDown(params);
+  std::vector<double> below;
+  for (const cv::Vec3d& x : motion->points)
+    if (down.dot(x) > 0) below.push_back(down.dot(x));
+  const double lowest = percentile(below, 0.9);
+  if (!(lowest > 0)) {
+    out.reason = "no tracks below the horizon";
+    return out;
+  }
+  const double scale = params.camera_height_m / lowest;
+  out.down = down;
+  out.second_from_first = Pose{motion->R, motion->t * scale};
+  out.point_index = motion->index;
+  for (const cv::Vec3d& x : motion->points) out.points.push_back(x * scale);
+  out.parallax_deg = median(motion->parallax_of);
+  out.ok = true;
   return out;
 }
 
@@ -260,20 +390,28 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
                              const std::vector<double>& sigma_m,
                              const std::vector<cv::Vec3d>& cameras, const cv::Vec3d& up,
                              double max_angle_deg, double tolerance_m, int min_points,
-                             double camera_sigma_m) {
+                             double camera_sigma_m, bool relative) {
   FloorFit out;
   const int n = static_cast<int>(points.size());
   if (n < std::max(3, min_points) || sigma_m.size() != points.size() || cameras.empty()) {
     out.reason = "too few landmarks";
     return out;
   }
+  // relative: the tolerances are shares of the cameras' median height above the plane
+  // (a map whose scale is not known yet).
+  auto unit_length = [&](const cv::Vec3d& u, double offset) {
+    if (!relative) return 1.0;
+    std::vector<double> heights;
+    for (const cv::Vec3d& c : cameras) heights.push_back(u.dot(c) - offset);
+    return std::max(0.0, median(heights));
+  };
   // A landmark's own noise widens its gate, up to twice the tolerance: the floor's far
   // edge meets a wall, whose lowest points a generous gate would tilt the floor to.
-  auto gate = [&](int i) { return std::min(2 * tolerance_m, std::max(tolerance_m, sigma_m[i])); };
+  auto gate = [&](int i, double tol) { return std::min(2 * tol, std::max(tol, sigma_m[i])); };
   // Below every camera: the floor is under the robot.
-  auto below = [&](const cv::Vec3d& u, double offset) {
+  auto below = [&](const cv::Vec3d& u, double offset, double tol) {
     for (const cv::Vec3d& c : cameras)
-      if (u.dot(c) - offset <= tolerance_m) return false;
+      if (u.dot(c) - offset <= tol) return false;
     return true;
   };
   // RANSAC over triples, deterministic (a fixed generator): repeatable maps.
@@ -291,9 +429,19 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
     if (u.dot(up) < 0) u = -u;
     if (u.dot(unit(up)) < cos_max) continue;
     const double offset = u.dot(points[a]);
-    if (!below(u, offset)) continue;
-    int count = 0;
-    for (int i = 0; i < n; ++i) count += std::abs(u.dot(points[i]) - offset) <= gate(i);
+    const double tol = tolerance_m * unit_length(u, offset);
+    if (!(tol > 0) || !below(u, offset, tol)) continue;
+    int count = 0, beyond = 0;
+    for (int i = 0; i < n; ++i) {
+      const double r = u.dot(points[i]) - offset;
+      count += std::abs(r) <= gate(i, tol);
+      beyond += -r > gate(i, tol);
+    }
+    // relative (the wider cone of an up-to-scale start): the floor is the lowest surface,
+    // a plane with landmarks below its gate (one through the floor and the foot of a
+    // wall, tilted) is not the floor (as floorStart's test). Measured on the synthetic
+    // humanoid (test_pose_estimator): map tilt 8.5 -> 2.3 deg.
+    if (relative && beyond * 5 > count) continue;
     if (count > best_count) {
       best_count = count;
       best_up = u;
@@ -306,15 +454,16 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
   }
   std::vector<double> weight(points.size());
   for (int i = 0; i < n; ++i) weight[i] = 1.0 / std::max(1e-6, sigma_m[i] * sigma_m[i]);
-  const double camera_weight =
-      camera_sigma_m > 0 ? 1.0 / (camera_sigma_m * camera_sigma_m) : 0.0;
   cv::Vec3d fit_up = best_up;
   double offset = best_offset;
   std::vector<int> use;
   for (int round = 0; round < 3; ++round) {
+    const double length = unit_length(fit_up, offset);
+    const double tol = tolerance_m * length, camera_sigma = camera_sigma_m * length;
+    const double camera_weight = camera_sigma > 0 ? 1.0 / (camera_sigma * camera_sigma) : 0.0;
     use.clear();
     for (int i = 0; i < n; ++i)
-      if (std::abs(fit_up.dot(points[i]) - offset) <= gate(i)) use.push_back(i);
+      if (std::abs(fit_up.dot(points[i]) - offset) <= gate(i, tol)) use.push_back(i);
     if (static_cast<int>(use.size()) < min_points ||
         !fitPlane(points, weight, use, cameras, camera_weight, best_up, fit_up, offset)) {
       out.reason = "no floor among the landmarks";

@@ -60,6 +60,7 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   distortion_ = d;
   pose_.emplace(K_, distortion_, params_.pose, params_.target);
   map_.reset();
+  pending_.clear();
   history_.clear();
   previous_planes_.clear();
   return {};
@@ -75,6 +76,7 @@ void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap,
 void PlanePipeline::reset() {
   if (pose_) pose_->reset();
   map_.reset();
+  pending_.clear();
   history_.clear();
   stream_.reset();
   previous_planes_.clear();
@@ -134,33 +136,25 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   // A rotation keeps the planes of the last image with parallax and their ids.
   if (!result.pure_rotation) assignImageIds(result.planes);
 
+  // camera_height: the planes seen while the start is checked wait (track ids, camera)
+  // and reach the map, corrected, once the check has passed; an undone start drops them.
+  if (pose_ && !pose_->scaleKnown()) {
+    // At most 1000 images (33 s at 30 images/s): an up-to-scale start waits for the
+    // floor without a time limit, memory must not.
+    if (pose_->checkingPose())
+      pending_.push_back({frame.stamp, *pose_->checkingPose(), result.planes});
+    else
+      pending_.clear();
+    if (pending_.size() > 1000) pending_.erase(pending_.begin());
+  }
   if (result.pose && pose_->scaleKnown()) {
-    std::vector<PlaneObservation> observations;
-    // A landmark's position along its ray is uncertain by about depth x (angular noise)
-    // / parallax: the angular noise from this pose's reprojection error (both rays).
-    const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
-    const double angle_sigma = std::sqrt(2.0) * std::max(0.3, result.pose->rms_px) / focal;
-    const auto& landmarks = pose_->landmarks();
-    for (const ImagePlane& p : result.planes) {
-      PlaneObservation obs;
-      obs.viewpoint = result.pose->map_from_camera.t;
-      for (auto id : p.inlier_ids)
-        if (const auto x = pose_->landmarkPosition(id)) {
-          obs.ids.push_back(id);
-          obs.points.push_back(*x);
-          const auto l = landmarks.find(id);
-          double sigma = params_.map.max_residual_m;
-          if (l != landmarks.end() && l->second.fixed) {
-            sigma = 0.001;
-          } else if (l != landmarks.end() && l->second.parallax_deg > 0) {
-            const double depth = cv::norm(*x - obs.viewpoint);
-            sigma = depth * angle_sigma / std::sin(l->second.parallax_deg * CV_PI / 180);
-          }
-          obs.sigma_m.push_back(sigma);
-        }
-      observations.push_back(std::move(obs));
+    for (PendingView& v : pending_) {
+      v.pose.map_from_camera = pose_->floorCorrectionApplied().apply(v.pose.map_from_camera);
+      map_.update(observationsOf(v.planes, v.pose), v.stamp);
     }
-    const std::vector<int> map_ids = map_.update(observations, frame.stamp);
+    pending_.clear();
+    const std::vector<int> map_ids =
+        map_.update(observationsOf(result.planes, *result.pose), frame.stamp);
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
 
@@ -193,6 +187,36 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     result.status += why.str();
   }
   return result;
+}
+
+std::vector<PlaneObservation> PlanePipeline::observationsOf(const std::vector<ImagePlane>& planes,
+                                                            const PoseEstimate& pose) const {
+  std::vector<PlaneObservation> observations;
+  // A landmark's position along its ray is uncertain by about depth x (angular noise)
+  // / parallax: the angular noise from this pose's reprojection error (both rays).
+  const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
+  const double angle_sigma = std::sqrt(2.0) * std::max(0.3, pose.rms_px) / focal;
+  const auto& landmarks = pose_->landmarks();
+  for (const ImagePlane& p : planes) {
+    PlaneObservation obs;
+    obs.viewpoint = pose.map_from_camera.t;
+    for (auto id : p.inlier_ids)
+      if (const auto x = pose_->landmarkPosition(id)) {
+        obs.ids.push_back(id);
+        obs.points.push_back(*x);
+        const auto l = landmarks.find(id);
+        double sigma = params_.map.max_residual_m;
+        if (l != landmarks.end() && l->second.fixed) {
+          sigma = 0.001;
+        } else if (l != landmarks.end() && l->second.parallax_deg > 0) {
+          const double depth = cv::norm(*x - obs.viewpoint);
+          sigma = depth * angle_sigma / std::sin(l->second.parallax_deg * CV_PI / 180);
+        }
+        obs.sigma_m.push_back(sigma);
+      }
+    observations.push_back(std::move(obs));
+  }
+  return observations;
 }
 
 std::vector<cv::Point2d> PlanePipeline::normalize(const std::vector<cv::Point2d>& pixels) const {

@@ -88,6 +88,8 @@ void PoseEstimator::reset() {
   floor_reason_.clear();
   floor_views_.clear();
   floor_check_.reset();
+  checking_pose_.reset();
+  correction_ = Similarity();
 }
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
@@ -100,6 +102,7 @@ std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const
 
 std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
                                                   const std::optional<Pose>& odom_from_camera) {
+  checking_pose_.reset();
   if (frame.ids.empty()) return {};
   // The target's corners become fixed landmarks whenever all four are tracked under new
   // ids (the first time, and when the tracker found the target again after a loss); the
@@ -139,11 +142,14 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
 
   if (metric_ == MetricSource::kNone) {
     if (!allows(MetricSource::kCameraHeight)) return {};  // no metres without a source
-    const std::optional<PoseEstimate> start = startFromFloor(frame, normalized);
+    bool unscaled = false;
+    const std::optional<PoseEstimate> start = startFromFloor(frame, normalized, unscaled);
     if (!start) return {};
     // Not given out before the floor landmarks have checked it (checkFloor).
-    floor_check_ = FloorCheck{{start->map_from_camera.t}, cv::Vec3d(0, 1, 0)};
-    floor_reason_ = "floor found, checking it against the map's floor";
+    floor_check_ = FloorCheck{{start->map_from_camera.t}, cv::Vec3d(0, 1, 0), unscaled};
+    if (unscaled) checking_pose_ = start;
+    floor_reason_ = unscaled ? "started up to scale, waiting for the map's floor"
+                             : "floor found, checking it against the map's floor";
     return {};
   }
   if (!initialised_) {  // nothing is triangulated before the start
@@ -175,7 +181,10 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   }
   triangulate(frame, normalized, estimate->map_from_camera);
   forgetOldLandmarks();
-  if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) return {};
+  if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) {
+    if (floor_check_ && floor_check_->unscaled) checking_pose_ = estimate;
+    return {};
+  }
   return estimate;
 }
 
@@ -195,11 +204,17 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   FloorCheck& check = *floor_check_;
   const FloorParams& p = params_.floor;
   check.cameras.push_back(estimate.map_from_camera.t);
+  // An up-to-scale start waits for its floor without a time limit: the path kept for the
+  // fit is bounded as the plane pipeline's waiting images (1000), the first one kept
+  // (the map's origin lies below it).
+  if (check.cameras.size() > 1000) check.cameras.erase(check.cameras.begin() + 1);
   // Motion in the start's units (near metres): the floor landmarks need views apart.
   double moved = 0;
   for (const cv::Vec3d& c : check.cameras)
     moved = std::max(moved, cv::norm(c - check.cameras.front()));
-  if (moved < p.check_motion * p.camera_height_m) {
+  // Up to scale the start's units are a guess: the motion is judged in the cameras'
+  // height above the floor fitted (below), not in camera_height_m.
+  if (!check.unscaled && moved < p.check_motion * p.camera_height_m) {
     floor_reason_ = "floor found, checking it: waiting for camera motion";
     return false;
   }
@@ -213,11 +228,40 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
     sigma.push_back(depth * angle / std::sin(l.parallax_deg * CV_PI / 180));
   }
   // Floor landmarks within 3 % of the height (the rendered floor's fit rms: 1.5 cm at 0.8 m).
-  const FloorFit fit = fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
-                                           p.max_check_angle_deg, 0.03 * p.camera_height_m,
-                                           p.min_check_points,
-                                           p.check_camera_sigma * p.camera_height_m);
-  if (!fit.ok) {
+  // Up to scale: the nominal up is only the camera's nominal pitch (a bobbing head's),
+  // so the floor is looked for within max_floor_angle_deg of it, with tolerances as
+  // shares of the cameras' height above each plane tried.
+  const FloorFit fit =
+      check.unscaled
+          ? fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
+                                p.max_floor_angle_deg, 0.03, p.min_check_points,
+                                p.check_camera_sigma, true)
+          : fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
+                                p.max_check_angle_deg, 0.03 * p.camera_height_m,
+                                p.min_check_points, p.check_camera_sigma * p.camera_height_m);
+  if (check.unscaled) {
+    // No start to undo: it waits for the floor landmarks (the camera's loss undoes it).
+    if (!fit.ok || angleDeg(fit.up, check.start_up) > p.max_floor_angle_deg) {
+      floor_reason_ = "started up to scale, waiting for the map's floor: " +
+                      (fit.ok ? std::string("too steep") : fit.reason);
+      return false;
+    }
+    std::vector<double> heights, spread;
+    for (const cv::Vec3d& c : check.cameras) heights.push_back(fit.up.dot(c) - fit.offset);
+    const double height = median(heights);
+    for (double h : heights) spread.push_back(std::abs(h - height));
+    // The camera stays at one height over the floor (within 3 sigma of its bobbing): a
+    // plane through a few floor landmarks and others, tilted, has the path climb it.
+    if (1.4826 * median(spread) > 3 * p.check_camera_sigma * height) {
+      floor_reason_ = "started up to scale, waiting for the map's floor: the camera's "
+                      "height over it varies";
+      return false;
+    }
+    if (moved < p.check_motion * height) {
+      floor_reason_ = "started up to scale, floor seen: waiting for camera motion";
+      return false;
+    }
+  } else if (!fit.ok) {
     // No floor within max_check_angle_deg of the start's: after three times the motion
     // the start was wrong (or the floor left the view), it is undone.
     if (moved > 3 * p.check_motion * p.camera_height_m)
@@ -228,8 +272,8 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   }
   const Similarity s =
       floorCorrection(fit, check.cameras, check.cameras.front(), p.camera_height_m);
-  if (angleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
-      std::abs(s.scale - 1) > p.max_check_scale) {
+  if (!check.unscaled && (angleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
+                          std::abs(s.scale - 1) > p.max_check_scale)) {
     undoFloorStart("the start's floor disagreed with the map's floor: started again");
     return false;
   }
@@ -239,6 +283,7 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   }
   estimate.map_from_camera = s.apply(estimate.map_from_camera);
   last_pose_ = estimate.map_from_camera;
+  correction_ = s;
   if (odom_from_camera) map_from_odom_ = estimate.map_from_camera * odom_from_camera->inverse();
   floor_check_.reset();
   floor_reason_.clear();
@@ -414,7 +459,8 @@ void PoseEstimator::placeStartLandmarks(const TrackFrame& frame,
 }
 
 std::optional<PoseEstimate> PoseEstimator::startFromFloor(
-    const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) {
+    const TrackFrame& frame, const std::vector<cv::Point2d>& normalized, bool& unscaled) {
+  unscaled = false;
   std::unordered_map<std::uint64_t, size_t> in_frame;
   for (size_t i = 0; i < frame.ids.size(); ++i) in_frame.emplace(frame.ids[i], i);
   // The tracks a kept view shares with this image: first and second view coordinates.
@@ -449,6 +495,7 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
   std::optional<FloorStart> floor;
   Pair shared;
   std::string reason = "waiting for camera motion";
+  bool floor_in_view = false;  // the oldest view's pair found a floor (confirmed or not)
   // The oldest view has the most parallax but may have lost its floor tracks: up to 4
   // views from the oldest to the newest are tried, the first that gives the floor wins.
   const size_t views = floor_views_.size(), tries = std::min<size_t>(4, views);
@@ -456,7 +503,10 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
     const size_t v = tries > 1 ? k * (views - 1) / (tries - 1) : 0;
     Pair p = pair(floor_views_[v]);
     FloorStart f = floorStart(p.a, p.b, K_(0, 0), params_.floor);
-    if (k == 0) reason = f.reason;
+    if (k == 0) {
+      reason = f.reason;
+      floor_in_view = f.ok || !f.floor_points.empty();
+    }
     // A floor of a few tracks can be a chance plane: it must be found again, the same
     // (down within max_floor_change_deg), in `confirmations` images in a row against the
     // same view (measured on the rendered wheeled room: one pair's down scatters by about
@@ -503,6 +553,18 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
       shared = std::move(p);
     }
   }
+  // No floor in the image between the oldest view and this one (a humanoid's head sees
+  // little of it): the map starts up to scale from that pair once it has the parallax,
+  // its up and scale left to the floor landmarks (checkFloor).
+  if (!floor && !floor_in_view && views > 0) {
+    Pair p = pair(floor_views_.front());
+    FloorStart f = unscaledStart(p.a, p.b, K_(0, 0), params_.floor);
+    if (f.ok) {
+      unscaled = true;
+      floor = std::move(f);
+      shared = std::move(p);
+    }
+  }
   if (keep) {
     floor_views_.push_back(FirstView{frame.ids, normalized, {}, 0, frame.stamp});
     // Full: the second oldest goes, so the oldest (most parallax) stays while it can.
@@ -544,8 +606,8 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
   }
   metric_ = MetricSource::kCameraHeight;
   floor_reason_.clear();
-  floor_views_.clear();
   placeStartLandmarks(frame, ids, b, points, points_map, floor->parallax_deg, map_from_second);
+  floor_views_.clear();
   return PoseEstimate{map_from_second, PoseSource::kLandmarks, static_cast<int>(points.size()), 0};
 }
 

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "mono_plane_detection/mapping/camera_height_scale.h"
+#include "mono_plane_detection/geometry/stats.h"
 #include "support/synthetic_tracks.h"
 
 using namespace mono_plane_detection;
@@ -64,8 +65,58 @@ TEST(CameraHeightScale, WheeledRobotsMotionInMetres) {
   EXPECT_GE(s.floor_points.size(), 20u);
 }
 
-// camera_height is for wheeled robots (a camera at a fixed height); the humanoid's head,
-// bobbing at 1.2 m, is covered by test_pose_estimator's CameraHeightGivesMetres only.
+// The humanoid's head (1.2 m, pitched 10 deg down, bobbing) sees a wall ahead and little
+// floor: the up-to-scale start gives the motion's direction and every track's point, in
+// the right shape, the up the nominal one and the scale a guess (corrected later by the
+// floor landmarks, fitFloorToLandmarks with relative tolerances).
+TEST(CameraHeightScale, UnscaledStartWithoutTheFloor) {
+  const SyntheticTracks world("humanoid", 100);
+  const TwoViews v = twoViews(world, 0.0, 2.0);
+  const FloorStart s = unscaledStart(v.first, v.second, world.camera.K()(0, 0), floorParams(1.2));
+  ASSERT_TRUE(s.ok) << s.reason;
+  EXPECT_TRUE(s.floor_points.empty());
+  const double pitch = 10 * CV_PI / 180;
+  EXPECT_LT(angleDeg(s.down, cv::Vec3d(0, std::cos(pitch), std::sin(pitch))), 1e-9);
+  EXPECT_LT(angleDeg(s.second_from_first.t, v.second_from_first.t), 10.0);  // measured 8.5
+  EXPECT_GE(s.parallax_deg, 4.0);
+  ASSERT_GE(s.points.size(), 30u);
+  // The points' shape: one scale takes them onto the true points (first camera frame);
+  // the guessed scale itself is within a factor of 2 here (the floor is in view at first).
+  const Pose w1 = trajectoryPose(world.trajectory, 0.0);
+  std::vector<double> ratios;
+  std::vector<cv::Vec3d> truth;
+  for (size_t j = 0; j < s.points.size(); ++j) {
+    // The true point: the one the first view's ray meets at the truth's depth.
+    const cv::Vec3d r(v.first[s.point_index[j]].x, v.first[s.point_index[j]].y, 1.0);
+    double best = 1e9;
+    cv::Vec3d found;
+    for (const cv::Vec3d& x : world.points) {
+      const cv::Vec3d c = w1.inverse().apply(x);
+      if (c[2] <= 0) continue;
+      const double miss = cv::norm(c / c[2] - r);
+      if (miss < best) {
+        best = miss;
+        found = c;
+      }
+    }
+    truth.push_back(found);
+    ratios.push_back(cv::norm(found) / cv::norm(s.points[j]));
+  }
+  const double scale = median(ratios);
+  EXPECT_GT(scale, 0.5);
+  EXPECT_LT(scale, 2.0);
+  std::vector<double> errors;
+  for (size_t j = 0; j < truth.size(); ++j)
+    errors.push_back(cv::norm(scale * s.points[j] - truth[j]) / cv::norm(truth[j]));
+  EXPECT_LT(median(errors), 0.05);
+  // Too little motion: not yet.
+  const TwoViews still = twoViews(world, 0.0, 0.1);
+  const FloorStart early =
+      unscaledStart(still.first, still.second, world.camera.K()(0, 0), floorParams(1.2));
+  EXPECT_FALSE(early.ok);
+  EXPECT_NE(early.reason.find("parallax"), std::string::npos) << early.reason;
+  EXPECT_FALSE(unscaledStart(v.first, v.second, world.camera.K()(0, 0), floorParams(0)).ok);
+}
 
 TEST(CameraHeightScale, SaysWhyNot) {
   const SyntheticTracks world("wheeled", 100);  // dense: the floor in view is small
@@ -180,6 +231,34 @@ TEST(CameraHeightScale, NoFloorLikeTheStartsIsFound) {
   const TiltedMap low = tiltedMap(0.0, -0.5);  // cameras below the "floor"
   EXPECT_FALSE(
       fitFloorToLandmarks(low.points, low.sigma, low.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30).ok);
+}
+
+TEST(CameraHeightScale, FloorFittedToAMapOfUnknownScale) {
+  // The same map three times too large and 15 deg off (an up-to-scale start): with the
+  // tolerances as shares of the cameras' height the same floor is found, and the
+  // correction brings the cameras to 0.8 m.
+  const double k = 3;
+  TiltedMap m = tiltedMap(15.0, 0.84);
+  for (cv::Vec3d& x : m.points) x *= k;
+  for (cv::Vec3d& c : m.cameras) c *= k;
+  for (double& s : m.sigma) s *= k;
+  const FloorFit fit = fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 25,
+                                           0.03, 30, 0.01, true);
+  ASSERT_TRUE(fit.ok) << fit.reason;
+  EXPECT_LT(angleDeg(fit.up, m.up), 0.3);
+  EXPECT_NEAR(fit.offset, k * m.offset, 0.03);
+  size_t wall = 0;
+  for (int i : fit.inliers) wall += static_cast<size_t>(i) >= m.floor_points;
+  EXPECT_EQ(wall, 0u);
+  EXPECT_GE(fit.inliers.size(), 75u);
+  const Similarity s = floorCorrection(fit, m.cameras, m.cameras.front(), 0.8);
+  EXPECT_NEAR(s.scale, 0.8 / (k * 0.84), 0.01);
+  for (const cv::Vec3d& c : m.cameras) EXPECT_NEAR(s.apply(c)[1], 0.8, 0.01);
+  // Absolute tolerances (the scaled start's) on this map: the floor's gate is three
+  // times too narrow for its noise and the 6 deg cone misses it.
+  EXPECT_FALSE(fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30,
+                                   0.008)
+                   .ok);
 }
 
 TEST(CameraHeightScale, TheCamerasPathFixesTheStripsTilt) {

@@ -31,7 +31,9 @@ TEST(PlanePipeline, MapsTheRoomsPlanesInMetres) {
   for (int k = 0; k < frames; ++k) {
     const PipelineResult r = pipeline.process(world.frame(k / 30.0));
     tracking += r.state == PipelineState::kTracking;
-    if (k > 10) EXPECT_FALSE(r.planes.empty()) << "frame " << k;
+    if (k > 10) {
+      EXPECT_FALSE(r.planes.empty()) << "frame " << k;
+    }
   }
   EXPECT_GE(tracking, frames - 40);  // all but the start (about 1 s of motion)
   std::vector<MapPlane> confirmed;
@@ -221,3 +223,39 @@ TEST(PlanePipeline, SlowMotionComparesWithAnOlderKeyframe) {
   EXPECT_GE(far_back, measured * 9 / 10);
 }
 
+
+// camera_height on the humanoid (no floor in the image: an up-to-scale start, checked by
+// its floor landmarks later): the planes seen while the start was being checked reach
+// the map once the check passes, so the map holds planes first seen before any pose was
+// given out.
+TEST(PlanePipeline, PlanesSeenWhileAnUnscaledStartIsCheckedAreMapped) {
+  const SyntheticTracks world("humanoid", 100);
+  PipelineParams params;
+  params.pose.metric_source = "camera_height";
+  params.pose.floor.camera_height_m = 1.2;
+  PlanePipeline pipeline(params);
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  double first_pose = -1;
+  bool map_before_pose = false;
+  for (int k = 0; k < 240; ++k) {
+    TrackFrame f = world.frame(k / 30.0), room = f;  // the room as if no target hung there
+    room.ids.clear();
+    room.pixels.clear();
+    room.target_corner.clear();
+    for (size_t i = 0; i < f.ids.size(); ++i)
+      if (!f.target_corner[i]) {
+        room.ids.push_back(f.ids[i]);
+        room.pixels.push_back(f.pixels[i]);
+        room.target_corner.push_back(false);
+      }
+    const PipelineResult r = pipeline.process(room);
+    if (!r.pose) map_before_pose |= !pipeline.map().planes().empty();
+    if (r.pose && first_pose < 0) first_pose = room.stamp;
+  }
+  ASSERT_GT(first_pose, 0) << "no metric start";
+  EXPECT_FALSE(map_before_pose) << "nothing is mapped before the check";
+  int earlier = 0;
+  for (const MapPlane& p : pipeline.map().planes())
+    earlier += p.confirmed(pipeline.map().params()) && p.first_seen < first_pose - 1.0;
+  EXPECT_GE(earlier, 1) << "no plane from the images seen while checking";
+}

@@ -283,14 +283,6 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
       est_cam.push_back(e->map_from_camera.t);
       true_cam.push_back(trajectoryPose(world.trajectory, t).t);
     }
-    if (path == "humanoid") {
-      // The head's bobbing, rolling floor never gives the same floor in enough images in
-      // a row (confirmations): no start, and nothing metric is given out.
-      EXPECT_EQ(posed, 0);
-      EXPECT_FALSE(estimator.scaleKnown());
-      EXPECT_NE(estimator.waitingFor().find("the floor"), std::string::npos);
-      continue;
-    }
     ASSERT_EQ(estimator.metricSource(), MetricSource::kCameraHeight) << estimator.waitingFor();
     // The map's frame is the floor's (its own origin and heading): compare after the
     // rigid motion (no scale) that best aligns the landmarks with the true points.
@@ -322,7 +314,10 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
     // Measured (wheeled): camera worst 9.7 % of the path (drift on these sparse tracks;
     // 0.4 % on the rendered room), map tilt 2.0 deg (4.1 before the floor check), height
     // at the first pose within 1 %; 118 images posed (the check against the floor
-    // landmarks withholds the first camera height of motion).
+    // landmarks withholds the first camera height of motion). The humanoid (no floor in
+    // the image: the up-to-scale start, its floor landmarks checked after the turn):
+    // 80 posed, landmarks' median error 0.08 m, camera worst 9.7 % of the path, map tilt
+    // 2.3 deg, height at the first pose within 0.1 % (before: no start at all).
     EXPECT_GE(posed, path == "wheeled" ? 100 : 60) << path;
     EXPECT_LT(point_errors[point_errors.size() / 2], 0.15) << path;
     EXPECT_LT(worst_cam, 0.12 * path_m) << path;

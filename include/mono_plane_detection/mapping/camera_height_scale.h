@@ -63,6 +63,16 @@ FloorStart floorStart(const std::vector<cv::Point2d>& first,
                       const std::vector<cv::Point2d>& second, double focal_px,
                       const FloorParams& params);
 
+// An up-to-scale start for a camera that sees too little floor in the image (a
+// humanoid's head): the motion from every track (as floorStart), every track
+// triangulated, `down` the nominal one (pitch_down_deg, roll 0) and the scale a guess
+// (the lowest tracks taken to lie camera_height_m down). Its up and scale are for the
+// floor landmarks to fix (fitFloorToLandmarks, floorCorrection). Needs min_check_points
+// triangulated tracks whose median parallax reaches min_parallax_deg. floor_points empty.
+FloorStart unscaledStart(const std::vector<cv::Point2d>& first,
+                         const std::vector<cv::Point2d>& second, double focal_px,
+                         const FloorParams& params);
+
 // The map frame the floor defines (core convention, y up): origin on the floor below the
 // first camera, y up (against `down`), z backwards along the floor (so the ROS map's x
 // is the camera's heading at the start). map_from_first camera.
@@ -76,6 +86,11 @@ Pose floorMapFromCamera(const cv::Vec3d& down, double camera_height_m);
 // camera_sigma_m > 0: the cameras stay at one height (a wheeled robot), their positions
 // (noise camera_sigma_m) share the floor's normal: a floor seen as a strip ahead fixes
 // its tilt about the strip poorly, the camera's motion along the floor fixes that.
+// relative: tolerance_m and camera_sigma_m are shares of the cameras' median height above
+// each plane tried (a map whose scale is not known yet: unscaledStart), and a plane with
+// more than a fifth as many landmarks below its gate as within it is not the floor (the
+// lowest surface: with an up-to-scale start's wide cone, a plane through the floor and
+// the foot of a wall, tilted, otherwise wins where the wall is dense).
 struct FloorFit {
   bool ok = false;
   std::string reason;            // why not, when !ok
@@ -88,7 +103,7 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
                              const std::vector<double>& sigma_m,
                              const std::vector<cv::Vec3d>& cameras, const cv::Vec3d& up,
                              double max_angle_deg, double tolerance_m, int min_points,
-                             double camera_sigma_m = 0);
+                             double camera_sigma_m = 0, bool relative = false);
 
 // x' = scale * R * x + t: a similarity of the map.
 struct Similarity {

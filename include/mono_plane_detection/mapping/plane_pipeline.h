@@ -111,6 +111,16 @@ class PlanePipeline {
                                          const std::optional<Pose>& pose,
                                          const std::vector<cv::Point2d>& normalized) const;
   std::vector<cv::Point2d> normalize(const std::vector<cv::Point2d>& pixels) const;
+  // The map's observations of these image planes from this pose (landmarks with sigmas).
+  std::vector<PlaneObservation> observationsOf(const std::vector<ImagePlane>& planes,
+                                               const PoseEstimate& pose) const;
+  // camera_height: images seen while the start was checked (PoseEstimator::checkingPose).
+  struct PendingView {
+    double stamp;
+    PoseEstimate pose;
+    std::vector<ImagePlane> planes;
+  };
+  std::vector<PendingView> pending_;
 
   std::deque<PastFrame> history_;
   GapCounter stream_;  // the tracks' rhythm: what counts as a pause

@@ -93,6 +93,16 @@ class PoseEstimator {
   bool scaleKnown() const { return metric_ != MetricSource::kNone && !floor_check_; }
   // kNone while a camera_height start is being checked (nothing metric is given out).
   MetricSource metricSource() const { return scaleKnown() ? metric_ : MetricSource::kNone; }
+  // camera_height, while an up-to-scale start waits for its floor: this image's pose in
+  // the start's (uncorrected) map, not given out; the plane map takes it once the check
+  // has corrected the start (floorCorrectionApplied), with what the planes showed
+  // meanwhile: that floor may come long after the planes seen first have left the view
+  // (a humanoid: image 250 of 300). Not after a floor start: its check comes after one
+  // camera height, and the planes seen before it, from the start's rougher landmarks,
+  // tilted the wheeled room's front wall 1.4 -> 4.0 deg.
+  const std::optional<PoseEstimate>& checkingPose() const { return checking_pose_; }
+  // The similarity the last floor check applied to the map (identity before).
+  const Similarity& floorCorrectionApplied() const { return correction_; }
   // What the start waits for, for people ("waiting for target", ...).
   std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
@@ -113,8 +123,10 @@ class PoseEstimator {
   std::optional<PoseEstimate> initialise(const TrackFrame& frame,
                                          const std::vector<cv::Point2d>& normalized);
   std::optional<PoseEstimate> targetPose(const TrackFrame& frame) const;
+  // unscaled: set when the map started up to scale (no floor in the image).
   std::optional<PoseEstimate> startFromFloor(const TrackFrame& frame,
-                                             const std::vector<cv::Point2d>& normalized);
+                                             const std::vector<cv::Point2d>& normalized,
+                                             bool& unscaled);
   // Landmarks of a two-view start; the second view is this frame.
   void placeStartLandmarks(const TrackFrame& frame, const std::vector<std::uint64_t>& ids,
                            const std::vector<cv::Point2d>& second, const std::vector<int>& points,
@@ -168,8 +180,14 @@ class PoseEstimator {
   struct FloorCheck {
     std::vector<cv::Vec3d> cameras;  // positions since the start, map frame
     cv::Vec3d start_up{0, 1, 0};     // the map's up as the start set it
+    // Started up to scale (unscaledStart): the floor is looked for within
+    // floor_max_angle_deg of the nominal up, its scale is not bounded, and the start is
+    // not undone for want of a floor.
+    bool unscaled = false;
   };
   std::optional<FloorCheck> floor_check_;
+  std::optional<PoseEstimate> checking_pose_;
+  Similarity correction_;
 };
 
 }  // namespace mono_plane_detection
