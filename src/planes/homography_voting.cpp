@@ -29,6 +29,51 @@ std::vector<cv::Point2d> select(const std::vector<cv::Point2d>& p, const std::ve
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
+// The points with active[i] (all when active is empty), ascending: the moves below work on
+// a plane's or two planes' points, and scanning every point for them took most of a
+// merge's time at 1000 points.
+std::vector<int> activeIndices(const std::vector<bool>& active, size_t n) {
+  std::vector<int> idx;
+  idx.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (isActive(active, i)) idx.push_back(static_cast<int>(i));
+  return idx;
+}
+
+// inliersOf over the points `among` (ascending: the result is then too).
+std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                              const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
+                              double threshold_px) {
+  std::vector<int> inliers;
+  for (int i : among)
+    if (transfersWithin(H, view1[i], view2[i], threshold_px)) inliers.push_back(i);
+  return inliers;
+}
+
+// refitPlane over the points `among` (ascending).
+bool refitAmong(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
+                const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
+                const PlaneParams& params) {
+  for (int round = 0; round < params.refit_iterations; ++round) {
+    std::vector<double> weights;
+    if (params.robust_refit) {
+      weights.reserve(inliers.size());
+      for (int i : inliers) {
+        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
+        weights.push_back(1.0 / (1.0 + r * r));
+      }
+    }
+    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
+    if (!fitted) return false;
+    H = *fitted;
+    std::vector<int> next = inliersAmong(H, view1, view2, among, params.vote_threshold_px);
+    if (next.size() < 4) return false;
+    if (next == inliers) break;
+    inliers = std::move(next);
+  }
+  return true;
+}
+
 double rmsError(const cv::Matx33d& H, const std::vector<int>& idx,
                 const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2) {
   double sum = 0.0;
@@ -68,11 +113,11 @@ struct Energy {
 // The plane's noise scale from its residuals over the points (medianScale from the
 // image pair's scale, kept within a factor 4 of it), and its threshold.
 void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1,
-                   const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
+                   const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
                    const Energy& energy, const PlaneParams& params) {
   std::vector<double> r;
-  for (size_t i = 0; i < view1.size(); ++i)
-    if (isActive(active, i)) r.push_back(transferError(plane.H, view1[i], view2[i]));
+  r.reserve(among.size());
+  for (int i : among) r.push_back(transferError(plane.H, view1[i], view2[i]));
   const double sigma = energy.sigma;
   const NoiseScale s = medianScale(r, sigma, params.noise.tail_sigmas);
   plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
@@ -99,8 +144,9 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        std::vector<bool> in_union(view1.size(), false);
-        for (int k : both) in_union[k] = true;
+        std::vector<int> in_union = both;  // ascending, each once
+        std::sort(in_union.begin(), in_union.end());
+        in_union.erase(std::unique(in_union.begin(), in_union.end()), in_union.end());
         PlaneParams p = params;
         p.vote_threshold_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
@@ -128,8 +174,9 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           if (!start) continue;
           HomographyPlane m;
           m.H = *start;
-          std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
-          if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
+          std::vector<int> union_inliers =
+              inliersAmong(m.H, view1, view2, in_union, p.vote_threshold_px);
+          if (union_inliers.size() < 4 || !refitAmong(m.H, union_inliers, view1, view2, in_union, p))
             continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
           m.threshold_px = p.vote_threshold_px;
@@ -179,6 +226,12 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     if (static_cast<int>(members.size()) < 2 * params.min_plane_support) continue;
     std::vector<bool> mine(view1.size(), false);
     for (int i : members) mine[i] = true;
+    auto among = [&members](const std::vector<bool>& active) {
+      std::vector<int> idx;
+      for (int i : members)
+        if (active[i]) idx.push_back(i);
+      return idx;
+    };
     auto best_candidate = [&](const std::vector<bool>& active, size_t max_votes) {
       int best = -1;
       size_t best_votes = 0;
@@ -203,15 +256,16 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     };
     auto make = [&](int c, const std::vector<bool>& active, HomographyPlane& out) {
       out.H = candidates[c];
-      out.inliers = inliersOf(out.H, view1, view2, active, vote_px);
+      const std::vector<int> idx = among(active);  // active is a subset of the members
+      out.inliers = inliersAmong(out.H, view1, view2, idx, vote_px);
       PlaneParams vp = params;
       vp.vote_threshold_px = vote_px;
       if (static_cast<int>(out.inliers.size()) < params.min_plane_support ||
-          !refitPlane(out.H, out.inliers, view1, view2, active, vp))
+          !refitAmong(out.H, out.inliers, view1, view2, idx, vp))
         return false;
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
-      setPlaneNoise(out, view1, view2, active, energy, params);
+      setPlaneNoise(out, view1, view2, idx, energy, params);
       return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
     };
     const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
@@ -317,9 +371,7 @@ void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
       }
       if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]), w))
         planes[k].H = *H;
-      std::vector<bool> mine(view1.size(), false);
-      for (int i : members[k]) mine[i] = true;
-      setPlaneNoise(planes[k], view1, view2, mine, energy, params);
+      setPlaneNoise(planes[k], view1, view2, members[k], energy, params);
     }
     std::vector<std::vector<int>> next =
         keepSupportedPlanes(planes, view1, view2, params, energy);
@@ -513,23 +565,7 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
 bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params) {
-  for (int round = 0; round < params.refit_iterations; ++round) {
-    std::vector<double> weights;
-    if (params.robust_refit) {
-      for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
-        weights.push_back(1.0 / (1.0 + r * r));
-      }
-    }
-    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
-    if (!fitted) return false;
-    H = *fitted;
-    std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
-    if (next.size() < 4) return false;
-    if (next == inliers) break;
-    inliers = std::move(next);
-  }
-  return true;
+  return refitAmong(H, inliers, view1, view2, activeIndices(active, view1.size()), params);
 }
 
 Thresholds fixedThresholds(const PlaneParams& params) {
@@ -820,7 +856,8 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
     bounds[vote.winner] = 0;  // used: never votes again
-    if (!refitPlane(plane.H, plane.inliers, view1, view2, active, params) ||
+    const std::vector<int> left = activeIndices(active, view1.size());
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
@@ -828,10 +865,10 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     // its points under its own threshold.
     plane.noise_px = th.sigma_px;
     plane.threshold_px = th.inlier_px;
-    setPlaneNoise(plane, view1, view2, active, energy, params);
+    setPlaneNoise(plane, view1, view2, left, energy, params);
     PlaneParams own = params;
     own.vote_threshold_px = plane.threshold_px;
-    if (!refitPlane(plane.H, plane.inliers, view1, view2, active, own) ||
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, own) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }

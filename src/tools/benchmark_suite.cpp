@@ -262,6 +262,7 @@ void benchTargets(int views) {
 int main(int argc, char** argv) {
   int count = 100, repeats = 20;
   bool planes_only = false;
+  int only_points = 0;
   std::string plot_path = "benchmark.png";
   cli::Parser cli("benchmark_suite", "[options]",
                   "  The benchmark suite: tracker and plane segmentation, ours against\n"
@@ -269,7 +270,8 @@ int main(int argc, char** argv) {
   cli.integer("frames", &count, 20, 100000, "generated frames per tracker row")
       .integer("repeats", &repeats, 1, 10000, "scenes per plane row")
       .text("plot", &plot_path, "where to write the plot", "FILE.png")
-      .flag("planes-only", &planes_only, "only the plane rows (no tracker, no target search)");
+      .flag("planes-only", &planes_only, "only the plane rows (no tracker, no target search)")
+      .integer("points", &only_points, 0, 100000, "only the plane row of this many points (0: all)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
   std::printf(
@@ -305,6 +307,7 @@ int main(int argc, char** argv) {
               "ratio", "ratio n", "ours err", "nod. err", "base err");
   std::vector<PlaneRow> rows;
   for (int points : {50, 200, 500, 1000}) {
+    if (only_points > 0 && points != only_points) continue;
     const PlaneRow r = benchPlanes(points, repeats);
     rows.push_back(r);
     std::printf(
