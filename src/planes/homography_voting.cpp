@@ -50,23 +50,24 @@ std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2
   return inliers;
 }
 
-// refitPlane over the points `among` (ascending).
+// refitPlane over the points `among` (ascending), at threshold_px (instead of
+// params.vote_threshold_px: no copy of the params, whose string the moves copied per call).
 bool refitAmong(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
-                const PlaneParams& params) {
+                const PlaneParams& params, double threshold_px) {
   for (int round = 0; round < params.refit_iterations; ++round) {
     std::vector<double> weights;
     if (params.robust_refit) {
       weights.reserve(inliers.size());
       for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
+        const double r = transferError(H, view1[i], view2[i]) / threshold_px;
         weights.push_back(1.0 / (1.0 + r * r));
       }
     }
     const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
     if (!fitted) return false;
     H = *fitted;
-    std::vector<int> next = inliersAmong(H, view1, view2, among, params.vote_threshold_px);
+    std::vector<int> next = inliersAmong(H, view1, view2, among, threshold_px);
     if (next.size() < 4) return false;
     if (next == inliers) break;
     inliers = std::move(next);
@@ -147,8 +148,7 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
         std::vector<int> in_union = both;  // ascending, each once
         std::sort(in_union.begin(), in_union.end());
         in_union.erase(std::unique(in_union.begin(), in_union.end()), in_union.end());
-        PlaneParams p = params;
-        p.vote_threshold_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
+        const double union_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
         // plane does not explain may go to a third plane or become an outlier).
         std::vector<double> others(both.size(), energy.k2);
@@ -175,11 +175,12 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           HomographyPlane m;
           m.H = *start;
           std::vector<int> union_inliers =
-              inliersAmong(m.H, view1, view2, in_union, p.vote_threshold_px);
-          if (union_inliers.size() < 4 || !refitAmong(m.H, union_inliers, view1, view2, in_union, p))
+              inliersAmong(m.H, view1, view2, in_union, union_px);
+          if (union_inliers.size() < 4 ||
+              !refitAmong(m.H, union_inliers, view1, view2, in_union, params, union_px))
             continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
-          m.threshold_px = p.vote_threshold_px;
+          m.threshold_px = union_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
           const double width = energy.widthCost(m);
@@ -258,10 +259,8 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
       out.H = candidates[c];
       const std::vector<int> idx = among(active);  // active is a subset of the members
       out.inliers = inliersAmong(out.H, view1, view2, idx, vote_px);
-      PlaneParams vp = params;
-      vp.vote_threshold_px = vote_px;
       if (static_cast<int>(out.inliers.size()) < params.min_plane_support ||
-          !refitAmong(out.H, out.inliers, view1, view2, idx, vp))
+          !refitAmong(out.H, out.inliers, view1, view2, idx, params, vote_px))
         return false;
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
@@ -565,7 +564,8 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
 bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params) {
-  return refitAmong(H, inliers, view1, view2, activeIndices(active, view1.size()), params);
+  return refitAmong(H, inliers, view1, view2, activeIndices(active, view1.size()), params,
+                    params.vote_threshold_px);
 }
 
 Thresholds fixedThresholds(const PlaneParams& params) {
@@ -857,7 +857,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     plane.inliers = std::move(vote.voters);
     bounds[vote.winner] = 0;  // used: never votes again
     const std::vector<int> left = activeIndices(active, view1.size());
-    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params) ||
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params, params.vote_threshold_px) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
@@ -866,9 +866,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     plane.noise_px = th.sigma_px;
     plane.threshold_px = th.inlier_px;
     setPlaneNoise(plane, view1, view2, left, energy, params);
-    PlaneParams own = params;
-    own.vote_threshold_px = plane.threshold_px;
-    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, own) ||
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params, plane.threshold_px) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
