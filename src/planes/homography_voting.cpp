@@ -29,6 +29,52 @@ std::vector<cv::Point2d> select(const std::vector<cv::Point2d>& p, const std::ve
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
+// Points' coordinates in separate arrays, for counting votes in vector instructions.
+struct PointArrays {
+  std::vector<double> ax, ay, bx, by;
+  void add(const cv::Point2d& a, const cv::Point2d& b) {
+    ax.push_back(a.x);
+    ay.push_back(a.y);
+    bx.push_back(b.x);
+    by.push_back(b.y);
+  }
+  size_t size() const { return ax.size(); }
+};
+
+constexpr size_t kVoteBlock = 32;
+
+// How many of the points [b0, b1) (at most kVoteBlock) H transfers within sqrt(t2) pixels:
+// transfersWithin's arithmetic, written so that it compiles to vector instructions (its
+// coefficients in locals, each point's outcome a 0/1 double summed after; a count in an
+// integer kept the compiler from vectorising: the vote's loops ran one point at a time).
+int votesInBlock(const cv::Matx33d& H, const PointArrays& p, size_t b0, size_t b1, double t2) {
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
+               h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double* ax = p.ax.data() + b0;
+  const double* ay = p.ay.data() + b0;
+  const double* bx = p.bx.data() + b0;
+  const double* by = p.by.data() + b0;
+  const size_t n = b1 - b0;
+  double in[kVoteBlock];
+  for (size_t i = 0; i < n; ++i) {
+    const double w = h6 * ax[i] + h7 * ay[i] + h8;
+    const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
+    const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
+    in[i] = (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w)) ? 1.0 : 0.0;
+  }
+  int votes = 0;
+  for (size_t i = 0; i < n; ++i) votes += in[i] != 0.0;
+  return votes;
+}
+
+// votesInBlock over all the points.
+int votesAmong(const cv::Matx33d& H, const PointArrays& p, double t2) {
+  int votes = 0;
+  for (size_t b0 = 0; b0 < p.size(); b0 += kVoteBlock)
+    votes += votesInBlock(H, p, b0, std::min(p.size(), b0 + kVoteBlock), t2);
+  return votes;
+}
+
 // The points with active[i] (all when active is empty), ascending: the moves below work on
 // a plane's or two planes' points, and scanning every point for them took most of a
 // merge's time at 1000 points.
@@ -238,32 +284,18 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
       size_t best_votes = 0;
       // The voters' coordinates in separate arrays, counted in blocks as in voteDominant
       // (vector instructions; the split's count cost more than the votes at 1000 points).
-      std::vector<double> ax, ay, bx, by;
-      for (int i : members) {
-        if (!active[i]) continue;
-        ax.push_back(view1[i].x);
-        ay.push_back(view1[i].y);
-        bx.push_back(view2[i].x);
-        by.push_back(view2[i].y);
-      }
-      const size_t m = ax.size();
+      PointArrays voters;
+      for (int i : members)
+        if (active[i]) voters.add(view1[i], view2[i]);
+      const size_t m = voters.size();
       const double t2 = vote_px * vote_px;
-      constexpr size_t kBlock = 32;
       for (size_t c = 0; c < candidates.size(); ++c) {
         // Counting stops once the candidate is over max_votes or cannot beat the best
         // (checked after each block): the same choice for a fraction of the work.
-        const cv::Matx33d& H = candidates[c];
         size_t votes = 0, left = m;
-        for (size_t b0 = 0; b0 < m; b0 += kBlock) {
-          const size_t b1 = std::min(m, b0 + kBlock);
-          size_t in_block = 0;
-          for (size_t i = b0; i < b1; ++i) {  // transfersWithin's test
-            const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
-            const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
-            const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
-            in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w));
-          }
-          votes += in_block;
+        for (size_t b0 = 0; b0 < m; b0 += kVoteBlock) {
+          const size_t b1 = std::min(m, b0 + kVoteBlock);
+          votes += static_cast<size_t>(votesInBlock(candidates[c], voters, b0, b1, t2));
           left -= b1 - b0;
           if (votes > max_votes || votes + left <= best_votes) break;
         }
@@ -522,34 +554,19 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
   // of points compiles to vector instructions (the arithmetic of transfersWithin).
   // The count of a homography stops after the block where the points left can no longer
   // make it beat the best so far (its bound is then what it could still reach).
-  std::vector<double> ax, ay, bx, by;
-  for (auto* v : {&ax, &ay, &bx, &by}) v->reserve(view1.size());
-  for (size_t i = 0; i < view1.size(); ++i) {
-    if (!isActive(active, i)) continue;
-    ax.push_back(view1[i].x);
-    ay.push_back(view1[i].y);
-    bx.push_back(view2[i].x);
-    by.push_back(view2[i].y);
-  }
-  const int m = static_cast<int>(ax.size());
+  PointArrays points;
+  for (size_t i = 0; i < view1.size(); ++i)
+    if (isActive(active, i)) points.add(view1[i], view2[i]);
+  const int m = static_cast<int>(points.size());
   const double t2 = threshold_px * threshold_px;
-  constexpr int kBlock = 32;
   for (int h : order) {
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
-    const cv::Matx33d& H = homographies[h];
     int votes = 0, left = m;
     bool complete = true;
-    for (int b0 = 0; b0 < m; b0 += kBlock) {
-      const int b1 = std::min(m, b0 + kBlock);
-      int in_block = 0;
-      for (int i = b0; i < b1; ++i) {
-        // transfersWithin's test on the arrays (no division: the vote's main cost).
-        const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
-        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
-        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
-        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w));
-      }
-      votes += in_block;
+    for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
+      const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
+      votes += votesInBlock(homographies[h], points, static_cast<size_t>(b0),
+                            static_cast<size_t>(b1), t2);
       left -= b1 - b0;
       if (left > 0 && !beats(votes + left, h)) {
         complete = false;
@@ -771,6 +788,99 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
   return estimateNoiseScale(candidates, view1, view2, np);
 }
 
+// The vote of segmentUnique repeated as planes take their points (paper IV-C among the
+// points left: most votes, the first on ties, a used candidate never again). Each
+// candidate's count over the active points is kept once known: when a plane's points
+// leave, it loses only their votes, counted over those points alone (the vote after the
+// first recounted every candidate over every point left, most of them in full, since a
+// candidate of another large plane cannot be ruled out early). Candidates whose count is
+// not known are counted as voteDominant counts them, stopping once they cannot win. The
+// same winners as voteDominant with bounds.
+class RepeatedVote {
+ public:
+  RepeatedVote(const std::vector<cv::Matx33d>& candidates, const std::vector<cv::Point2d>& view1,
+               const std::vector<cv::Point2d>& view2, double threshold_px)
+      : candidates_(candidates), view1_(view1), view2_(view2), threshold_px_(threshold_px),
+        count_(candidates.size(), -1), bound_(candidates.size(), std::numeric_limits<int>::max()),
+        retired_(candidates.size(), false) {}
+
+  Vote next(const std::vector<bool>& active) {
+    Vote vote;
+    auto beats = [&vote](int votes, int h) {
+      return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
+    };
+    std::vector<int> unknown;
+    for (size_t h = 0; h < candidates_.size(); ++h) {
+      if (retired_[h]) continue;
+      if (count_[h] < 0) {
+        unknown.push_back(static_cast<int>(h));
+      } else if (beats(count_[h], static_cast<int>(h))) {
+        vote.votes = count_[h];
+        vote.winner = static_cast<int>(h);
+      }
+    }
+    // The likeliest winners first, so that the rest stop early or are skipped.
+    std::stable_sort(unknown.begin(), unknown.end(),
+                     [this](int a, int b) { return bound_[a] > bound_[b]; });
+    PointArrays points;
+    for (size_t i = 0; i < view1_.size(); ++i)
+      if (active[i]) points.add(view1_[i], view2_[i]);
+    const int m = static_cast<int>(points.size());
+    const double t2 = threshold_px_ * threshold_px_;
+    for (int h : unknown) {
+      if (!beats(bound_[h], h)) continue;
+      int votes = 0, left = m;
+      bool complete = true;
+      for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
+        const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
+        votes += votesInBlock(candidates_[h], points, static_cast<size_t>(b0),
+                              static_cast<size_t>(b1), t2);
+        left -= b1 - b0;
+        if (left > 0 && !beats(votes + left, h)) {
+          complete = false;
+          votes += left;  // an upper bound on its count
+          break;
+        }
+      }
+      bound_[h] = std::min(bound_[h], votes);
+      if (!complete) continue;
+      count_[h] = votes;
+      if (beats(votes, h)) {
+        vote.votes = votes;
+        vote.winner = h;
+      }
+    }
+    if (vote.winner >= 0)
+      vote.voters = inliersOf(candidates_[vote.winner], view1_, view2_, active, threshold_px_);
+    return vote;
+  }
+
+  // Candidate h won (or failed as a plane): it never votes again.
+  void retire(int h) { retired_[static_cast<size_t>(h)] = true; }
+
+  // These active points leave the vote: the known counts lose their votes.
+  void leave(const std::vector<int>& points) {
+    PointArrays leaving;
+    for (int i : points) leaving.add(view1_[i], view2_[i]);
+    const double t2 = threshold_px_ * threshold_px_;
+    for (size_t h = 0; h < candidates_.size(); ++h) {
+      if (retired_[h] || count_[h] <= 0) continue;
+      const int lost = votesAmong(candidates_[h], leaving, t2);
+      count_[h] -= lost;
+      bound_[h] = count_[h];
+    }
+  }
+
+ private:
+  const std::vector<cv::Matx33d>& candidates_;
+  const std::vector<cv::Point2d>& view1_;
+  const std::vector<cv::Point2d>& view2_;
+  double threshold_px_;
+  std::vector<int> count_;  // votes over the active points, -1 unknown
+  std::vector<int> bound_;  // at least its votes over the active points
+  std::vector<bool> retired_;
+};
+
 // Indices of the first copy of every correspondence; dup_of[i] = index of i's first copy.
 std::vector<int> uniqueCorrespondences(const std::vector<cv::Point2d>& view1,
                                        const std::vector<cv::Point2d>& view2,
@@ -867,14 +977,14 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   // Paper IV-C repeated: the winner becomes a plane, its points leave the vote, while a
   // plane pays its label cost.
   std::vector<HomographyPlane> planes;
-  std::vector<int> bounds(candidates.size(), std::numeric_limits<int>::max());
+  RepeatedVote repeated(candidates, view1, view2, params.vote_threshold_px);
   while (static_cast<int>(planes.size()) < params.max_planes) {
-    Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px, &bounds);
+    Vote vote = repeated.next(active);
     if (vote.winner < 0 || vote.votes < std::min(5, params.min_plane_support)) break;
     HomographyPlane plane;
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
-    bounds[vote.winner] = 0;  // used: never votes again
+    repeated.retire(vote.winner);  // used: never votes again
     const std::vector<int> left = activeIndices(active, view1.size());
     if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params, params.vote_threshold_px) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
@@ -894,6 +1004,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i], width);
     if (gain <= 0.0) break;  // the best left does not pay for itself: neither will the rest
     for (int i : plane.inliers) active[i] = false;
+    repeated.leave(plane.inliers);
     planes.push_back(std::move(plane));
   }
   refineAssignment(planes, view1, view2, params, energy);
