@@ -12,24 +12,32 @@ namespace mono_plane_detection {
 namespace {
 
 // msseScale, also giving the largest inlier residual (the inlier set's cut).
+// expected: about how many inliers there will be (the last estimate's on a refit), 0
+// unknown; only how much is sorted first depends on it, not the result.
 NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model_dof,
-                       double stop_sigmas, double* cut) {
+                       double stop_sigmas, double* cut, size_t expected = 0) {
   residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
                                  [](double r) { return !std::isfinite(r); }),
                   residuals.end());
   const int n = static_cast<int>(residuals.size());
   min_inliers = std::max(min_inliers, model_dof / 2 + 1);  // 2k - dof > 0
   if (n < min_inliers) return {};
-  // Sorted lazily: the smallest part first, the rest only when the inliers reach into it
-  // (a good candidate stops early; this runs for every pilot candidate).
-  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, n / 2));
+  // Sorted lazily: the smallest part first (half, or a quarter more than the expected
+  // inliers), then twice as much each time the inliers reach beyond it (a good candidate
+  // stops early; this runs for every pilot candidate and refit, and sorting was most of it).
+  const size_t first = expected > 0 ? expected + expected / 4 + 2 : static_cast<size_t>(n) / 2;
+  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, first));
   std::nth_element(residuals.begin(), residuals.begin() + static_cast<long>(sorted) - 1,
                    residuals.end());
   std::sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted));
   auto ensure = [&](int k) {
-    if (static_cast<size_t>(k) >= sorted) {
-      std::sort(residuals.begin() + static_cast<long>(sorted), residuals.end());
-      sorted = residuals.size();
+    while (static_cast<size_t>(k) >= sorted) {
+      const size_t more = std::min(residuals.size(), 2 * sorted);
+      std::nth_element(residuals.begin() + static_cast<long>(sorted),
+                       residuals.begin() + static_cast<long>(more) - 1, residuals.end());
+      std::sort(residuals.begin() + static_cast<long>(sorted),
+                residuals.begin() + static_cast<long>(more));
+      sorted = more;
     }
   };
   double sum = 0.0;
@@ -152,7 +160,8 @@ const RefitStep& refitStep(const std::vector<char>& in, const std::vector<cv::Po
     step.fitted = true;
     step.H = *refit;
     step.r = transferResiduals(*refit, view1, view2);
-    step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut);
+    step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut,
+                             static_cast<size_t>(std::count(in.begin(), in.end(), 1)));
   }
   memo.push_back(std::move(step));
   return memo.back();
