@@ -99,13 +99,20 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   auto nearest = [&](double floor2) {
     std::vector<std::pair<double, int>> best;
     best.reserve(k + 1);
+    // worst2: the k-th distance so far (infinity until k are in), a single comparison
+    // rejecting most points once the list is full.
+    double worst2 = std::numeric_limits<double>::infinity();
     auto consider = [&](int j) {
       const double dx = points_[j].x - a.x, dy = points_[j].y - a.y;
       const double d2 = dx * dx + dy * dy;
+      if (d2 > worst2 || d2 < floor2 || j == seed) return;
       const std::pair<double, int> key(d2, j);
-      if (j == seed || d2 < floor2 || (best.size() == k && !(key < best.back()))) return;
-      best.insert(std::upper_bound(best.begin(), best.end(), key), key);
-      if (best.size() > k) best.pop_back();
+      if (best.size() == k && !(key < best.back())) return;
+      // Insertion from the back (the list is short and sorted).
+      if (best.size() == k) best.pop_back();
+      best.push_back(key);
+      for (size_t m = best.size() - 1; m > 0 && key < best[m - 1]; --m) std::swap(best[m], best[m - 1]);
+      if (best.size() == k) worst2 = best.back().first;
     };
     if (cell_start_.empty()) {
       for (int j = 0; j < n; ++j) consider(j);

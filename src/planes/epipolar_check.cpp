@@ -86,14 +86,19 @@ std::optional<cv::Matx33d> refineFundamental(const std::vector<cv::Point2d>& vie
   std::vector<double> w(view1.size(), 1.0);
   cv::Matx33d F;
   for (int round = 0; round <= rounds; ++round) {
+    // The normal matrix's upper triangle summed, then mirrored: the same sums as the
+    // full a a^T per point (a product commutes exactly) at half the work.
     cv::Matx<double, 9, 9> M = cv::Matx<double, 9, 9>::zeros();
     for (size_t i = 0; i < view1.size(); ++i) {
       const cv::Vec3d x = T1 * homogeneous(view1[i]), y = T2 * homogeneous(view2[i]);
-      cv::Matx<double, 9, 1> a;
+      double a[9];
       for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) a(3 * r + c) = y[r] * x[c];
-      M += (a * a.t()) * w[i];
+        for (int c = 0; c < 3; ++c) a[3 * r + c] = y[r] * x[c];
+      for (int r = 0; r < 9; ++r)
+        for (int c = r; c < 9; ++c) M(r, c) += a[r] * a[c] * w[i];
     }
+    for (int r = 0; r < 9; ++r)
+      for (int c = 0; c < r; ++c) M(r, c) = M(c, r);
     cv::Matx<double, 9, 1> values;
     cv::Matx<double, 9, 9> vectors;
     cv::eigen(M, values, vectors);

@@ -29,6 +29,104 @@ std::vector<cv::Point2d> select(const std::vector<cv::Point2d>& p, const std::ve
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
+// Points' coordinates in separate arrays, for counting votes in vector instructions.
+struct PointArrays {
+  std::vector<double> ax, ay, bx, by;
+  void add(const cv::Point2d& a, const cv::Point2d& b) {
+    ax.push_back(a.x);
+    ay.push_back(a.y);
+    bx.push_back(b.x);
+    by.push_back(b.y);
+  }
+  size_t size() const { return ax.size(); }
+};
+
+constexpr size_t kVoteBlock = 32;
+
+// How many of the points [b0, b1) (at most kVoteBlock) H transfers within sqrt(t2) pixels:
+// transfersWithin's arithmetic, written so that it compiles to vector instructions (its
+// coefficients in locals, each point's outcome a 0/1 double summed after; a count in an
+// integer kept the compiler from vectorising: the vote's loops ran one point at a time).
+int votesInBlock(const cv::Matx33d& H, const PointArrays& p, size_t b0, size_t b1, double t2) {
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
+               h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double* ax = p.ax.data() + b0;
+  const double* ay = p.ay.data() + b0;
+  const double* bx = p.bx.data() + b0;
+  const double* by = p.by.data() + b0;
+  const size_t n = b1 - b0;
+  double in[kVoteBlock];
+  for (size_t i = 0; i < n; ++i) {
+    const double w = h6 * ax[i] + h7 * ay[i] + h8;
+    const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
+    const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
+    in[i] = (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w)) ? 1.0 : 0.0;
+  }
+  // Summed as doubles (0/1: exact in any order), two chains.
+  double even = 0.0, odd = 0.0;
+  size_t i = 0;
+  for (; i + 1 < n; i += 2) {
+    even += in[i];
+    odd += in[i + 1];
+  }
+  if (i < n) even += in[i];
+  return static_cast<int>(even + odd);
+}
+
+// votesInBlock over all the points.
+int votesAmong(const cv::Matx33d& H, const PointArrays& p, double t2) {
+  int votes = 0;
+  for (size_t b0 = 0; b0 < p.size(); b0 += kVoteBlock)
+    votes += votesInBlock(H, p, b0, std::min(p.size(), b0 + kVoteBlock), t2);
+  return votes;
+}
+
+// The points with active[i] (all when active is empty), ascending: the moves below work on
+// a plane's or two planes' points, and scanning every point for them took most of a
+// merge's time at 1000 points.
+std::vector<int> activeIndices(const std::vector<bool>& active, size_t n) {
+  std::vector<int> idx;
+  idx.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (isActive(active, i)) idx.push_back(static_cast<int>(i));
+  return idx;
+}
+
+// inliersOf over the points `among` (ascending: the result is then too).
+std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                              const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
+                              double threshold_px) {
+  std::vector<int> inliers;
+  for (int i : among)
+    if (transfersWithin(H, view1[i], view2[i], threshold_px)) inliers.push_back(i);
+  return inliers;
+}
+
+// refitPlane over the points `among` (ascending), at threshold_px (instead of
+// params.vote_threshold_px: no copy of the params, whose string the moves copied per call).
+bool refitAmong(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
+                const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
+                const PlaneParams& params, double threshold_px) {
+  for (int round = 0; round < params.refit_iterations; ++round) {
+    std::vector<double> weights;
+    if (params.robust_refit) {
+      weights.reserve(inliers.size());
+      for (int i : inliers) {
+        const double r = transferError(H, view1[i], view2[i]) / threshold_px;
+        weights.push_back(1.0 / (1.0 + r * r));
+      }
+    }
+    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
+    if (!fitted) return false;
+    H = *fitted;
+    std::vector<int> next = inliersAmong(H, view1, view2, among, threshold_px);
+    if (next.size() < 4) return false;
+    if (next == inliers) break;
+    inliers = std::move(next);
+  }
+  return true;
+}
+
 double rmsError(const cv::Matx33d& H, const std::vector<int>& idx,
                 const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2) {
   double sum = 0.0;
@@ -68,11 +166,11 @@ struct Energy {
 // The plane's noise scale from its residuals over the points (medianScale from the
 // image pair's scale, kept within a factor 4 of it), and its threshold.
 void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1,
-                   const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
+                   const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
                    const Energy& energy, const PlaneParams& params) {
   std::vector<double> r;
-  for (size_t i = 0; i < view1.size(); ++i)
-    if (isActive(active, i)) r.push_back(transferError(plane.H, view1[i], view2[i]));
+  r.reserve(among.size());
+  for (int i : among) r.push_back(transferError(plane.H, view1[i], view2[i]));
   const double sigma = energy.sigma;
   const NoiseScale s = medianScale(r, sigma, params.noise.tail_sigmas);
   plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
@@ -99,10 +197,10 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        std::vector<bool> in_union(view1.size(), false);
-        for (int k : both) in_union[k] = true;
-        PlaneParams p = params;
-        p.vote_threshold_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
+        std::vector<int> in_union = both;  // ascending, each once
+        std::sort(in_union.begin(), in_union.end());
+        in_union.erase(std::unique(in_union.begin(), in_union.end()), in_union.end());
+        const double union_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
         // plane does not explain may go to a third plane or become an outlier).
         std::vector<double> others(both.size(), energy.k2);
@@ -128,11 +226,13 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           if (!start) continue;
           HomographyPlane m;
           m.H = *start;
-          std::vector<int> union_inliers = inliersOf(m.H, view1, view2, in_union, p.vote_threshold_px);
-          if (union_inliers.size() < 4 || !refitPlane(m.H, union_inliers, view1, view2, in_union, p))
+          std::vector<int> union_inliers =
+              inliersAmong(m.H, view1, view2, in_union, union_px);
+          if (union_inliers.size() < 4 ||
+              !refitAmong(m.H, union_inliers, view1, view2, in_union, params, union_px))
             continue;
           m.noise_px = std::max(planes[i].noise_px, planes[j].noise_px);
-          m.threshold_px = p.vote_threshold_px;
+          m.threshold_px = union_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
           const double width = energy.widthCost(m);
@@ -179,19 +279,30 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     if (static_cast<int>(members.size()) < 2 * params.min_plane_support) continue;
     std::vector<bool> mine(view1.size(), false);
     for (int i : members) mine[i] = true;
+    auto among = [&members](const std::vector<bool>& active) {
+      std::vector<int> idx;
+      for (int i : members)
+        if (active[i]) idx.push_back(i);
+      return idx;
+    };
     auto best_candidate = [&](const std::vector<bool>& active, size_t max_votes) {
       int best = -1;
       size_t best_votes = 0;
-      std::vector<int> voters;
+      // The voters' coordinates in separate arrays, counted in blocks as in voteDominant
+      // (vector instructions; the split's count cost more than the votes at 1000 points).
+      PointArrays voters;
       for (int i : members)
-        if (active[i]) voters.push_back(i);
+        if (active[i]) voters.add(view1[i], view2[i]);
+      const size_t m = voters.size();
+      const double t2 = vote_px * vote_px;
       for (size_t c = 0; c < candidates.size(); ++c) {
-        // Counting stops once the candidate is over max_votes or cannot beat the best:
-        // the same choice for a fraction of the work.
-        size_t votes = 0, left = voters.size();
-        for (int i : voters) {
-          votes += transfersWithin(candidates[c], view1[i], view2[i], vote_px);
-          --left;
+        // Counting stops once the candidate is over max_votes or cannot beat the best
+        // (checked after each block): the same choice for a fraction of the work.
+        size_t votes = 0, left = m;
+        for (size_t b0 = 0; b0 < m; b0 += kVoteBlock) {
+          const size_t b1 = std::min(m, b0 + kVoteBlock);
+          votes += static_cast<size_t>(votesInBlock(candidates[c], voters, b0, b1, t2));
+          left -= b1 - b0;
           if (votes > max_votes || votes + left <= best_votes) break;
         }
         if (votes > best_votes && votes <= max_votes) {
@@ -203,15 +314,14 @@ void splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     };
     auto make = [&](int c, const std::vector<bool>& active, HomographyPlane& out) {
       out.H = candidates[c];
-      out.inliers = inliersOf(out.H, view1, view2, active, vote_px);
-      PlaneParams vp = params;
-      vp.vote_threshold_px = vote_px;
+      const std::vector<int> idx = among(active);  // active is a subset of the members
+      out.inliers = inliersAmong(out.H, view1, view2, idx, vote_px);
       if (static_cast<int>(out.inliers.size()) < params.min_plane_support ||
-          !refitPlane(out.H, out.inliers, view1, view2, active, vp))
+          !refitAmong(out.H, out.inliers, view1, view2, idx, params, vote_px))
         return false;
       out.noise_px = planes[p].noise_px;
       out.threshold_px = planes[p].threshold_px;
-      setPlaneNoise(out, view1, view2, active, energy, params);
+      setPlaneNoise(out, view1, view2, idx, energy, params);
       return static_cast<int>(out.inliers.size()) >= params.min_plane_support;
     };
     const int a = best_candidate(mine, static_cast<size_t>(0.8 * members.size()));
@@ -317,9 +427,7 @@ void refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
       }
       if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]), w))
         planes[k].H = *H;
-      std::vector<bool> mine(view1.size(), false);
-      for (int i : members[k]) mine[i] = true;
-      setPlaneNoise(planes[k], view1, view2, mine, energy, params);
+      setPlaneNoise(planes[k], view1, view2, members[k], energy, params);
     }
     std::vector<std::vector<int>> next =
         keepSupportedPlanes(planes, view1, view2, params, energy);
@@ -452,34 +560,19 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
   // of points compiles to vector instructions (the arithmetic of transfersWithin).
   // The count of a homography stops after the block where the points left can no longer
   // make it beat the best so far (its bound is then what it could still reach).
-  std::vector<double> ax, ay, bx, by;
-  for (auto* v : {&ax, &ay, &bx, &by}) v->reserve(view1.size());
-  for (size_t i = 0; i < view1.size(); ++i) {
-    if (!isActive(active, i)) continue;
-    ax.push_back(view1[i].x);
-    ay.push_back(view1[i].y);
-    bx.push_back(view2[i].x);
-    by.push_back(view2[i].y);
-  }
-  const int m = static_cast<int>(ax.size());
+  PointArrays points;
+  for (size_t i = 0; i < view1.size(); ++i)
+    if (isActive(active, i)) points.add(view1[i], view2[i]);
+  const int m = static_cast<int>(points.size());
   const double t2 = threshold_px * threshold_px;
-  constexpr int kBlock = 32;
   for (int h : order) {
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
-    const cv::Matx33d& H = homographies[h];
     int votes = 0, left = m;
     bool complete = true;
-    for (int b0 = 0; b0 < m; b0 += kBlock) {
-      const int b1 = std::min(m, b0 + kBlock);
-      int in_block = 0;
-      for (int i = b0; i < b1; ++i) {
-        // transfersWithin's test on the arrays (no division: the vote's main cost).
-        const double w = H(2, 0) * ax[i] + H(2, 1) * ay[i] + H(2, 2);
-        const double dx = (H(0, 0) * ax[i] + H(0, 1) * ay[i] + H(0, 2)) - bx[i] * w;
-        const double dy = (H(1, 0) * ax[i] + H(1, 1) * ay[i] + H(1, 2)) - by[i] * w;
-        in_block += (std::abs(w) >= 1e-12) & (dx * dx + dy * dy < t2 * (w * w));
-      }
-      votes += in_block;
+    for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
+      const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
+      votes += votesInBlock(homographies[h], points, static_cast<size_t>(b0),
+                            static_cast<size_t>(b1), t2);
       left -= b1 - b0;
       if (left > 0 && !beats(votes + left, h)) {
         complete = false;
@@ -513,23 +606,8 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
 bool refitPlane(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
                 const std::vector<cv::Point2d>& view2, const std::vector<bool>& active,
                 const PlaneParams& params) {
-  for (int round = 0; round < params.refit_iterations; ++round) {
-    std::vector<double> weights;
-    if (params.robust_refit) {
-      for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / params.vote_threshold_px;
-        weights.push_back(1.0 / (1.0 + r * r));
-      }
-    }
-    const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
-    if (!fitted) return false;
-    H = *fitted;
-    std::vector<int> next = inliersOf(H, view1, view2, active, params.vote_threshold_px);
-    if (next.size() < 4) return false;
-    if (next == inliers) break;
-    inliers = std::move(next);
-  }
-  return true;
+  return refitAmong(H, inliers, view1, view2, activeIndices(active, view1.size()), params,
+                    params.vote_threshold_px);
 }
 
 Thresholds fixedThresholds(const PlaneParams& params) {
@@ -605,8 +683,22 @@ struct GroupDraw {
     while (tried < max_tries_ && sampler_.next(g)) {
       ++tried;
       PointGroup key = g;
-      for (size_t a = 1; a < key.size(); ++a)  // insertion sort: 5 values, std::sort's overhead
-        for (size_t b = a; b > 0 && key[b] < key[b - 1]; --b) std::swap(key[b], key[b - 1]);
+      // Sorted by a network of 9 compare-exchanges (min and max, no branches: the
+      // insertion sort's mispredicted branches were a tenth of the draw).
+      auto exchange = [&key](int a, int b) {
+        const int lo = std::min(key[a], key[b]), hi = std::max(key[a], key[b]);
+        key[a] = lo;
+        key[b] = hi;
+      };
+      exchange(0, 1);
+      exchange(3, 4);
+      exchange(2, 4);
+      exchange(2, 3);
+      exchange(0, 3);
+      exchange(0, 2);
+      exchange(1, 4);
+      exchange(1, 3);
+      exchange(1, 2);
       if (!firstTime(key)) continue;
       // Groups of one four follow each other (fifth_points > 1): its homography once.
       if (!have_four_ || !std::equal(g.begin(), g.begin() + 4, four_.begin())) {
@@ -716,13 +808,129 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
   return estimateNoiseScale(candidates, view1, view2, np);
 }
 
+// The vote of segmentUnique repeated as planes take their points (paper IV-C among the
+// points left: most votes, the first on ties, a used candidate never again). Each
+// candidate's count over the active points is kept once known: when a plane's points
+// leave, it loses only their votes, counted over those points alone (the vote after the
+// first recounted every candidate over every point left, most of them in full, since a
+// candidate of another large plane cannot be ruled out early). Candidates whose count is
+// not known are counted as voteDominant counts them, stopping once they cannot win. The
+// same winners as voteDominant with bounds.
+class RepeatedVote {
+ public:
+  RepeatedVote(const std::vector<cv::Matx33d>& candidates, const std::vector<cv::Point2d>& view1,
+               const std::vector<cv::Point2d>& view2, double threshold_px)
+      : candidates_(candidates), view1_(view1), view2_(view2), threshold_px_(threshold_px),
+        count_(candidates.size(), -1), bound_(candidates.size(), std::numeric_limits<int>::max()),
+        retired_(candidates.size(), false) {}
+
+  Vote next(const std::vector<bool>& active) {
+    Vote vote;
+    auto beats = [&vote](int votes, int h) {
+      return votes > vote.votes || (votes == vote.votes && votes > 0 && h < vote.winner);
+    };
+    std::vector<int> unknown;
+    for (size_t h = 0; h < candidates_.size(); ++h) {
+      if (retired_[h]) continue;
+      if (count_[h] < 0) {
+        unknown.push_back(static_cast<int>(h));
+      } else if (beats(count_[h], static_cast<int>(h))) {
+        vote.votes = count_[h];
+        vote.winner = static_cast<int>(h);
+      }
+    }
+    // The likeliest winners first, so that the rest stop early or are skipped.
+    std::stable_sort(unknown.begin(), unknown.end(),
+                     [this](int a, int b) { return bound_[a] > bound_[b]; });
+    PointArrays points;
+    for (size_t i = 0; i < view1_.size(); ++i)
+      if (active[i]) points.add(view1_[i], view2_[i]);
+    const int m = static_cast<int>(points.size());
+    const double t2 = threshold_px_ * threshold_px_;
+    for (int h : unknown) {
+      if (!beats(bound_[h], h)) continue;
+      int votes = 0, left = m;
+      bool complete = true;
+      for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
+        const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
+        votes += votesInBlock(candidates_[h], points, static_cast<size_t>(b0),
+                              static_cast<size_t>(b1), t2);
+        left -= b1 - b0;
+        if (left > 0 && !beats(votes + left, h)) {
+          complete = false;
+          votes += left;  // an upper bound on its count
+          break;
+        }
+      }
+      bound_[h] = std::min(bound_[h], votes);
+      if (!complete) continue;
+      count_[h] = votes;
+      if (beats(votes, h)) {
+        vote.votes = votes;
+        vote.winner = h;
+      }
+    }
+    if (vote.winner >= 0)
+      vote.voters = inliersOf(candidates_[vote.winner], view1_, view2_, active, threshold_px_);
+    return vote;
+  }
+
+  // Candidate h won (or failed as a plane): it never votes again.
+  void retire(int h) { retired_[static_cast<size_t>(h)] = true; }
+
+  // These active points leave the vote: the known counts lose their votes.
+  void leave(const std::vector<int>& points) {
+    PointArrays leaving;
+    for (int i : points) leaving.add(view1_[i], view2_[i]);
+    const double t2 = threshold_px_ * threshold_px_;
+    for (size_t h = 0; h < candidates_.size(); ++h) {
+      if (retired_[h] || count_[h] <= 0) continue;
+      const int lost = votesAmong(candidates_[h], leaving, t2);
+      count_[h] -= lost;
+      bound_[h] = count_[h];
+    }
+  }
+
+ private:
+  const std::vector<cv::Matx33d>& candidates_;
+  const std::vector<cv::Point2d>& view1_;
+  const std::vector<cv::Point2d>& view2_;
+  double threshold_px_;
+  std::vector<int> count_;  // votes over the active points, -1 unknown
+  std::vector<int> bound_;  // at least its votes over the active points
+  std::vector<bool> retired_;
+};
+
 // Indices of the first copy of every correspondence; dup_of[i] = index of i's first copy.
 std::vector<int> uniqueCorrespondences(const std::vector<cv::Point2d>& view1,
                                        const std::vector<cv::Point2d>& view2,
                                        std::vector<int>& dup_of) {
-  std::map<std::tuple<double, double, double, double>, int> first;
   std::vector<int> keep;
   dup_of.assign(view1.size(), -1);
+  auto key = [&](size_t i) { return std::make_tuple(view1[i].x, view1[i].y, view2[i].x, view2[i].y); };
+  bool all_finite = true;
+  for (size_t i = 0; i < view1.size(); ++i) all_finite = all_finite && finite(view1[i]) && finite(view2[i]);
+  if (all_finite) {
+    // The indices sorted by their four coordinates (ties by index): each run of equal
+    // ones starts with its first copy. The same as the map below without a node per point
+    // (a tenth of a millisecond at 1000 points); the map stays for non-finite input, whose
+    // comparisons are not an order.
+    std::vector<int> order(view1.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      const auto ka = key(static_cast<size_t>(a)), kb = key(static_cast<size_t>(b));
+      return ka < kb || (!(kb < ka) && a < b);
+    });
+    for (size_t r = 0; r < order.size(); ++r) {
+      const size_t i = static_cast<size_t>(order[r]);
+      const bool same = r > 0 && !(key(static_cast<size_t>(order[r - 1])) < key(i));
+      dup_of[i] = same ? dup_of[static_cast<size_t>(order[r - 1])] : static_cast<int>(i);
+    }
+    for (size_t i = 0; i < view1.size(); ++i)
+      if (dup_of[i] == static_cast<int>(i)) keep.push_back(static_cast<int>(i));
+    return keep;
+  }
+  std::map<std::tuple<double, double, double, double>, int> first;
   for (size_t i = 0; i < view1.size(); ++i) {
     const auto key = std::make_tuple(view1[i].x, view1[i].y, view2[i].x, view2[i].y);
     const auto it = first.emplace(key, static_cast<int>(i));
@@ -812,15 +1020,16 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
   // Paper IV-C repeated: the winner becomes a plane, its points leave the vote, while a
   // plane pays its label cost.
   std::vector<HomographyPlane> planes;
-  std::vector<int> bounds(candidates.size(), std::numeric_limits<int>::max());
+  RepeatedVote repeated(candidates, view1, view2, params.vote_threshold_px);
   while (static_cast<int>(planes.size()) < params.max_planes) {
-    Vote vote = voteDominant(candidates, view1, view2, active, params.vote_threshold_px, &bounds);
+    Vote vote = repeated.next(active);
     if (vote.winner < 0 || vote.votes < std::min(5, params.min_plane_support)) break;
     HomographyPlane plane;
     plane.H = candidates[vote.winner];
     plane.inliers = std::move(vote.voters);
-    bounds[vote.winner] = 0;  // used: never votes again
-    if (!refitPlane(plane.H, plane.inliers, view1, view2, active, params) ||
+    repeated.retire(vote.winner);  // used: never votes again
+    const std::vector<int> left = activeIndices(active, view1.size());
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params, params.vote_threshold_px) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
@@ -828,10 +1037,8 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     // its points under its own threshold.
     plane.noise_px = th.sigma_px;
     plane.threshold_px = th.inlier_px;
-    setPlaneNoise(plane, view1, view2, active, energy, params);
-    PlaneParams own = params;
-    own.vote_threshold_px = plane.threshold_px;
-    if (!refitPlane(plane.H, plane.inliers, view1, view2, active, own) ||
+    setPlaneNoise(plane, view1, view2, left, energy, params);
+    if (!refitAmong(plane.H, plane.inliers, view1, view2, left, params, plane.threshold_px) ||
         static_cast<int>(plane.inliers.size()) < params.min_plane_support) {
       continue;
     }
@@ -840,6 +1047,7 @@ PlaneSegmentation segmentUnique(const std::vector<cv::Point2d>& view1,
     for (int i : plane.inliers) gain += energy.k2 - energy.point(plane, view1[i], view2[i], width);
     if (gain <= 0.0) break;  // the best left does not pay for itself: neither will the rest
     for (int i : plane.inliers) active[i] = false;
+    repeated.leave(plane.inliers);
     planes.push_back(std::move(plane));
   }
   refineAssignment(planes, view1, view2, params, energy);

@@ -12,24 +12,32 @@ namespace mono_plane_detection {
 namespace {
 
 // msseScale, also giving the largest inlier residual (the inlier set's cut).
+// expected: about how many inliers there will be (the last estimate's on a refit), 0
+// unknown; only how much is sorted first depends on it, not the result.
 NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model_dof,
-                       double stop_sigmas, double* cut) {
+                       double stop_sigmas, double* cut, size_t expected = 0) {
   residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
                                  [](double r) { return !std::isfinite(r); }),
                   residuals.end());
   const int n = static_cast<int>(residuals.size());
   min_inliers = std::max(min_inliers, model_dof / 2 + 1);  // 2k - dof > 0
   if (n < min_inliers) return {};
-  // Sorted lazily: the smallest part first, the rest only when the inliers reach into it
-  // (a good candidate stops early; this runs for every pilot candidate).
-  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, n / 2));
+  // Sorted lazily: the smallest part first (half, or a quarter more than the expected
+  // inliers), then twice as much each time the inliers reach beyond it (a good candidate
+  // stops early; this runs for every pilot candidate and refit, and sorting was most of it).
+  const size_t first = expected > 0 ? expected + expected / 4 + 2 : static_cast<size_t>(n) / 2;
+  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, first));
   std::nth_element(residuals.begin(), residuals.begin() + static_cast<long>(sorted) - 1,
                    residuals.end());
   std::sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted));
   auto ensure = [&](int k) {
-    if (static_cast<size_t>(k) >= sorted) {
-      std::sort(residuals.begin() + static_cast<long>(sorted), residuals.end());
-      sorted = residuals.size();
+    while (static_cast<size_t>(k) >= sorted) {
+      const size_t more = std::min(residuals.size(), 2 * sorted);
+      std::nth_element(residuals.begin() + static_cast<long>(sorted),
+                       residuals.begin() + static_cast<long>(more) - 1, residuals.end());
+      std::sort(residuals.begin() + static_cast<long>(sorted),
+                residuals.begin() + static_cast<long>(more));
+      sorted = more;
     }
   };
   double sum = 0.0;
@@ -81,21 +89,35 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
   // F = 1 - exp(-c^2 / 2) the share below the cut (1.1774 sigma for a wide cut).
   const double share = 1.0 - std::exp(-0.5 * cut_sigmas * cut_sigmas);
   const double median_in_sigmas = std::sqrt(-2.0 * std::log(1.0 - 0.5 * share));
+  // The residuals under the largest cut so far sorted (the rest kept apart, unsorted):
+  // each round's set under its cut is a prefix, its median and 90th percentile two
+  // look-ups, the same order statistics as selecting them in every round (two selections
+  // per round of up to 30). The cut mostly shrinks, so most residuals are never sorted.
+  std::vector<double> sorted, rest;
+  sorted.reserve(residuals.size());
+  rest.reserve(residuals.size());
+  double bound = -std::numeric_limits<double>::infinity();  // sorted: every finite r < bound
+  for (double r : residuals)
+    if (std::isfinite(r)) rest.push_back(r);
   NoiseScale s{sigma0, 0};
-  std::vector<double> in;
   for (int it = 0; it < iterations; ++it) {
     const double cut = cut_sigmas * s.sigma_px;
-    in.clear();
-    for (double r : residuals)
-      if (std::isfinite(r) && r < cut) in.push_back(r);
-    if (in.empty()) return {};
-    std::nth_element(in.begin(), in.begin() + in.size() / 2, in.end());
-    const double next = in[in.size() / 2] / median_in_sigmas;
+    if (cut > bound) {  // the residuals in [bound, cut) join the sorted ones, after them
+      const auto mid = std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
+      const size_t old = sorted.size();
+      sorted.insert(sorted.end(), rest.begin(), mid);
+      rest.erase(rest.begin(), mid);
+      std::sort(sorted.begin() + static_cast<long>(old), sorted.end());
+      bound = cut;
+    }
+    const size_t in = static_cast<size_t>(
+        std::lower_bound(sorted.begin(), sorted.end(), cut) - sorted.begin());  // r < cut
+    if (in == 0) return {};
+    const double median = sorted[in / 2];
+    const double next = median / median_in_sigmas;
     const bool converged = std::abs(next - s.sigma_px) < 1e-3 * s.sigma_px;
-    const double median = in[in.size() / 2];
-    std::nth_element(in.begin(), in.begin() + (in.size() * 9) / 10, in.end());
-    const double q90 = in[(in.size() * 9) / 10];
-    s = {next, static_cast<int>(in.size()), median > 0 ? q90 / median : 0.0};
+    const double q90 = sorted[(in * 9) / 10];
+    s = {next, static_cast<int>(in), median > 0 ? q90 / median : 0.0};
     if (converged || !(next > 0)) break;
   }
   return s;
@@ -107,39 +129,64 @@ double asscScore(const NoiseScale& s) {
   return s.inliers > 0 ? s.inliers / (s.sigma_px * s.sigma_px) : 0.0;
 }
 
+// One refit step of refine: the homography least squares gives on an inlier set, its
+// residuals, and their MSSE scale and cut. It depends on the inlier set only, and the
+// candidates of one image pair mostly converge to the same few sets (the dominant
+// plane's), so each set's step is computed once per estimate and looked up after.
+struct RefitStep {
+  std::vector<char> in;
+  bool fitted = false;
+  cv::Matx33d H;
+  std::vector<double> r;
+  NoiseScale scale;
+  double cut = 0.0;
+};
+
+const RefitStep& refitStep(const std::vector<char>& in, const std::vector<cv::Point2d>& view1,
+                           const std::vector<cv::Point2d>& view2, const NoiseScaleParams& params,
+                           std::vector<RefitStep>& memo) {
+  for (const RefitStep& step : memo)
+    if (step.in == in) return step;
+  RefitStep step;
+  step.in = in;
+  std::vector<cv::Point2d> a, b;
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (in[i]) {
+      a.push_back(view1[i]);
+      b.push_back(view2[i]);
+    }
+  }
+  if (const auto refit = fitHomography(a, b)) {
+    step.fitted = true;
+    step.H = *refit;
+    step.r = transferResiduals(*refit, view1, view2);
+    step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut,
+                             static_cast<size_t>(std::count(in.begin(), in.end(), 1)));
+  }
+  memo.push_back(std::move(step));
+  return memo.back();
+}
+
 // Refits H on the inlier set of `scale` (residuals r under H, cut: its largest inlier
 // residual) and estimates again while ASSC's score improves. Each round's residuals and
 // cut come from the previous one (recomputing them took a third of the estimate).
 NoiseScale refine(cv::Matx33d& H, NoiseScale scale, std::vector<double> r, double cut,
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
-                  const NoiseScaleParams& params) {
-  std::vector<cv::Point2d> a, b;
+                  const NoiseScaleParams& params, std::vector<RefitStep>& memo) {
   std::vector<char> in(r.size()), was;
   for (int round = 0; round < 3; ++round) {
-    a.clear();
-    b.clear();
-    for (size_t i = 0; i < r.size(); ++i) {
-      in[i] = r[i] <= cut;
-      if (in[i]) {
-        a.push_back(view1[i]);
-        b.push_back(view2[i]);
-      }
-    }
+    for (size_t i = 0; i < r.size(); ++i) in[i] = r[i] <= cut;
     // The same inlier set as the last refit's: it would give the same homography and
     // score, which does not improve on itself (converged).
     if (in == was) break;
     was = in;
-    const auto refit = fitHomography(a, b);
-    if (!refit) break;
-    std::vector<double> next_r = transferResiduals(*refit, view1, view2);
-    double next_cut = 0.0;
-    const NoiseScale next =
-        msseWithCut(next_r, params.min_inliers, 8, params.stop_sigmas, &next_cut);
-    if (asscScore(next) <= asscScore(scale)) break;
-    H = *refit;
-    scale = next;
-    r = std::move(next_r);
-    cut = next_cut;
+    const RefitStep& step = refitStep(in, view1, view2, params, memo);
+    if (!step.fitted) break;
+    if (asscScore(step.scale) <= asscScore(scale)) break;
+    H = step.H;
+    scale = step.scale;
+    r = step.r;
+    cut = step.cut;
   }
   return scale;
 }
@@ -158,12 +205,13 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   // those of the plane, not of the sample's own noise.
   NoiseScale best;
   std::optional<cv::Matx33d> best_h;
+  std::vector<RefitStep> memo;
   for (cv::Matx33d H : candidates) {
     std::vector<double> r = transferResiduals(H, view1, view2);
     double cut = 0.0;
     NoiseScale s = msseWithCut(r, params.min_inliers, 8, params.stop_sigmas, &cut);
     if (s.inliers == 0 || !(s.sigma_px > 0)) continue;
-    s = refine(H, s, std::move(r), cut, view1, view2, params);
+    s = refine(H, s, std::move(r), cut, view1, view2, params, memo);
     if (asscScore(s) > asscScore(best)) {
       best = s;
       best_h = H;

@@ -261,25 +261,34 @@ void benchTargets(int views) {
 
 int main(int argc, char** argv) {
   int count = 100, repeats = 20;
+  bool planes_only = false;
+  int only_points = 0;
   std::string plot_path = "benchmark.png";
   cli::Parser cli("benchmark_suite", "[options]",
                   "  The benchmark suite: tracker and plane segmentation, ours against\n"
                   "  baselines, with a plot. Figures, never pass/fail.");
   cli.integer("frames", &count, 20, 100000, "generated frames per tracker row")
       .integer("repeats", &repeats, 1, 10000, "scenes per plane row")
-      .text("plot", &plot_path, "where to write the plot", "FILE.png");
+      .text("plot", &plot_path, "where to write the plot", "FILE.png")
+      .flag("planes-only", &planes_only, "only the plane rows (no tracker, no target search)")
+      .integer("points", &only_points, 0, 100000, "only the plane row of this many points (0: all)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
   std::printf(
       "benchmark_suite: one thread; %d generated frames per tracker row, %d scenes per "
       "plane row.\n\n",
       count, repeats);
-  std::printf(
-      "Tracker (ours) against goodFeaturesToTrack + calcOpticalFlowPyrLK (baseline),\n"
-      "ms per frame, mean / p95:\n");
-  std::printf("  %-10s %6s %16s %16s %8s\n", "image", "feat.", "ours", "baseline", "ratio");
+  if (!planes_only) {
+    std::printf(
+        "Tracker (ours) against goodFeaturesToTrack + calcOpticalFlowPyrLK (baseline),\n"
+        "ms per frame, mean / p95:\n");
+    std::printf("  %-10s %6s %16s %16s %8s\n", "image", "feat.", "ours", "baseline", "ratio");
+  }
   std::vector<std::pair<int, std::pair<double, double>>> tracker_vga;
-  for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480), cv::Size(1280, 720)}) {
+  const std::vector<cv::Size> sizes =
+      planes_only ? std::vector<cv::Size>{}
+                  : std::vector<cv::Size>{{320, 240}, {640, 480}, {1280, 720}};
+  for (const cv::Size size : sizes) {
     const std::vector<cv::Mat> images = frames(size, count);
     for (int features : {50, 150, 500}) {
       const Stats ours = stats(timeTracker(images, features));
@@ -298,6 +307,7 @@ int main(int argc, char** argv) {
               "ratio", "ratio n", "ours err", "nod. err", "base err");
   std::vector<PlaneRow> rows;
   for (int points : {50, 200, 500, 1000}) {
+    if (only_points > 0 && points != only_points) continue;
     const PlaneRow r = benchPlanes(points, repeats);
     rows.push_back(r);
     std::printf(
@@ -306,7 +316,7 @@ int main(int argc, char** argv) {
         r.baseline.p95, r.ours.mean / r.baseline.mean, r.ours_nodelet.mean / r.baseline.mean,
         r.our_error, r.nodelet_error, r.baseline_error);
   }
-  benchTargets(std::max(20, count / 2));
+  if (!planes_only) benchTargets(std::max(20, count / 2));
   plot(rows, tracker_vga, plot_path);
   std::printf("\nplot: %s\n", plot_path.c_str());
   return 0;

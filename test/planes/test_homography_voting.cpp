@@ -273,6 +273,32 @@ TEST(SegmentPlanes, DuplicatesCountOnce) {
     for (int i : p.inliers) EXPECT_EQ(twice.labels[i], &p - &twice.planes[0] + 1);
 }
 
+// The first copy is the earliest wherever the repeats are; -0 and +0 are the same
+// coordinate (the deduplication sorts indices for finite input, a map otherwise).
+TEST(SegmentPlanes, DuplicatesAnywhereAndSignedZeros) {
+  TwoViewSceneParams sp;
+  sp.planes = 2;
+  const auto scene = makeTwoViewScene(sp);
+  auto v1 = scene.view1, v2 = scene.view2;
+  v1[3] = {0.0, 120.0};
+  v2[3] = {0.0, 118.0};
+  v1.insert(v1.begin(), v1[10]);  // a repeat of (now) index 11, before it
+  v2.insert(v2.begin(), v2[10]);
+  v1.push_back({-0.0, 120.0});  // a repeat of (now) index 4, signed zero
+  v2.push_back({-0.0, 118.0});
+  const auto r = segmentPlanes(v1, v2);
+  EXPECT_EQ(r.duplicates, 2);
+  ASSERT_EQ(r.labels.size(), v1.size());
+  EXPECT_EQ(r.labels[0], r.labels[11]);
+  EXPECT_EQ(r.labels.back(), r.labels[4]);
+  // Non-finite input takes the other path and counts the same repeats.
+  v1.push_back({std::nan(""), 1.0});
+  v2.push_back({1.0, 1.0});
+  const auto n = segmentPlanes(v1, v2);
+  EXPECT_EQ(n.duplicates, 2);
+  EXPECT_EQ(n.labels[0], n.labels[11]);
+}
+
 // Repeated texture matched one period off: points that follow a homography (a true
 // plane's, shifted in view 2) but not the epipolar geometry of the scene. With the
 // epipolar check (default) that "plane" is dropped and its points are outliers; without
