@@ -79,7 +79,7 @@ std::optional<Motion> measureMotion(const std::vector<cv::Point2d>& first,
       std::vector<cv::Mat> Rs, ts, normals;
       cv::decomposeHomographyMat(Hm, cv::Mat::eye(3, 3, CV_64F), Rs, ts, normals);
       const cv::Matx34d P1(1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0);
-      int best = -1;
+      int best = 0;  // a decomposition no track agrees with keeps the essential motion
       std::vector<uchar> best_mask;
       for (size_t c = 0; c < Rs.size(); ++c) {
         const cv::Matx33d R(Rs[c]);

@@ -145,7 +145,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       pending_.push_back({frame.stamp, *pose_->checkingPose(), result.planes});
     else
       pending_.clear();
-    if (pending_.size() > 1000) pending_.erase(pending_.begin());
+    if (pending_.size() > 1000) pending_.pop_front();
   }
   if (result.pose && pose_->scaleKnown()) {
     for (PendingView& v : pending_) {

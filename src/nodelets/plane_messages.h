@@ -21,7 +21,8 @@ namespace mono_plane_detection {
 TrackFrame toTrackFrame(const Tracks& msg, std::string& error);
 
 // Empty when the tracker's start-up target (as Tracks says: type and size) is the one
-// `own` describes, or when the message does not say; else both, for the user to fix.
+// `own` describes, or when the message does not say (empty target_type); else both,
+// for the user to fix.
 // Sizes agree within 1e-4 relative (Tracks carries float32).
 std::string targetMismatch(const Tracks& msg, const TargetParams& own);
 

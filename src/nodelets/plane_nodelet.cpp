@@ -13,7 +13,6 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <algorithm>
 #include <deque>
 #include <fstream>
 #include <map>
@@ -384,14 +383,12 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
       last_tracks_size_ = frame.size;
       // Corners of a target of another size than ours would fix a wrong scale (two
-      // nodelets configured apart): refused, loudly, until they agree.
-      if (std::find(frame.target_corner.begin(), frame.target_corner.end(), true) !=
-          frame.target_corner.end()) {
-        target_mismatch_ = targetMismatch(*msg, node_.pipeline.target);
-        if (!target_mismatch_.empty()) {
-          NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
-          frame.target_corner.assign(frame.target_corner.size(), false);
-        }
+      // nodelets configured apart): refused, loudly, until they agree. Every message says
+      // the tracker's target, so a tracker relaunched with the right one clears it at once.
+      target_mismatch_ = targetMismatch(*msg, node_.pipeline.target);
+      if (!target_mismatch_.empty()) {
+        NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
+        frame.target_corner.assign(frame.target_corner.size(), false);
       }
       if (!info_size_.empty() && info_size_ != frame.size)
         NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",

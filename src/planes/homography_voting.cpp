@@ -73,6 +73,32 @@ int votesInBlock(const cv::Matx33d& H, const PointArrays& p, size_t b0, size_t b
   return static_cast<int>(even + odd);
 }
 
+// H's count over the points, block by block, stopping after the block where even every
+// point left could no longer make it win (`can_win(votes + left)` false): then it is not
+// `complete` and `votes` is an upper bound on its count (the vote's early stop).
+struct BlockCount {
+  int votes = 0;
+  bool complete = true;
+};
+template <class CanWin>
+BlockCount countWhileItCanWin(const cv::Matx33d& H, const PointArrays& p, double t2,
+                              CanWin can_win) {
+  BlockCount count;
+  const size_t m = p.size();
+  size_t left = m;
+  for (size_t b0 = 0; b0 < m; b0 += kVoteBlock) {
+    const size_t b1 = std::min(m, b0 + kVoteBlock);
+    count.votes += votesInBlock(H, p, b0, b1, t2);
+    left -= b1 - b0;
+    if (left > 0 && !can_win(count.votes + static_cast<int>(left))) {
+      count.complete = false;
+      count.votes += static_cast<int>(left);
+      break;
+    }
+  }
+  return count;
+}
+
 // votesInBlock over all the points.
 int votesAmong(const cv::Matx33d& H, const PointArrays& p, double t2) {
   int votes = 0;
@@ -563,27 +589,14 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
   PointArrays points;
   for (size_t i = 0; i < view1.size(); ++i)
     if (isActive(active, i)) points.add(view1[i], view2[i]);
-  const int m = static_cast<int>(points.size());
   const double t2 = threshold_px * threshold_px;
   for (int h : order) {
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
-    int votes = 0, left = m;
-    bool complete = true;
-    for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
-      const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
-      votes += votesInBlock(homographies[h], points, static_cast<size_t>(b0),
-                            static_cast<size_t>(b1), t2);
-      left -= b1 - b0;
-      if (left > 0 && !beats(votes + left, h)) {
-        complete = false;
-        votes += left;  // an upper bound on its count
-        break;
-      }
-    }
-    if (vote_bounds) (*vote_bounds)[h] = std::min((*vote_bounds)[h], votes);
-    if (!complete) continue;
-    if (beats(votes, h)) {
-      vote.votes = votes;
+    const BlockCount count = countWhileItCanWin(homographies[h], points, t2,
+                                                [&](int reach) { return beats(reach, h); });
+    if (vote_bounds) (*vote_bounds)[h] = std::min((*vote_bounds)[h], count.votes);
+    if (count.complete && beats(count.votes, h)) {
+      vote.votes = count.votes;
       vote.winner = h;
     }
   }
@@ -845,28 +858,16 @@ class RepeatedVote {
     PointArrays points;
     for (size_t i = 0; i < view1_.size(); ++i)
       if (active[i]) points.add(view1_[i], view2_[i]);
-    const int m = static_cast<int>(points.size());
     const double t2 = threshold_px_ * threshold_px_;
     for (int h : unknown) {
       if (!beats(bound_[h], h)) continue;
-      int votes = 0, left = m;
-      bool complete = true;
-      for (int b0 = 0; b0 < m; b0 += static_cast<int>(kVoteBlock)) {
-        const int b1 = std::min(m, b0 + static_cast<int>(kVoteBlock));
-        votes += votesInBlock(candidates_[h], points, static_cast<size_t>(b0),
-                              static_cast<size_t>(b1), t2);
-        left -= b1 - b0;
-        if (left > 0 && !beats(votes + left, h)) {
-          complete = false;
-          votes += left;  // an upper bound on its count
-          break;
-        }
-      }
-      bound_[h] = std::min(bound_[h], votes);
-      if (!complete) continue;
-      count_[h] = votes;
-      if (beats(votes, h)) {
-        vote.votes = votes;
+      const BlockCount count = countWhileItCanWin(candidates_[h], points, t2,
+                                                  [&](int reach) { return beats(reach, h); });
+      bound_[h] = std::min(bound_[h], count.votes);
+      if (!count.complete) continue;
+      count_[h] = count.votes;
+      if (beats(count.votes, h)) {
+        vote.votes = count.votes;
         vote.winner = h;
       }
     }

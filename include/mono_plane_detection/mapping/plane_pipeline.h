@@ -120,7 +120,7 @@ class PlanePipeline {
     PoseEstimate pose;
     std::vector<ImagePlane> planes;
   };
-  std::vector<PendingView> pending_;
+  std::deque<PendingView> pending_;  // the oldest dropped first
 
   std::deque<PastFrame> history_;
   GapCounter stream_;  // the tracks' rhythm: what counts as a pause
