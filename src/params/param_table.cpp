@@ -86,9 +86,9 @@ const ParamTable<TrackerParams>& trackerParamTable() {
       {"quality_level", field(&P::quality_level), 1e-6, 0.999, "",
        "corner score threshold, fraction of the strongest corner's score"},
       {"block_size", field(&P::block_size), 1, 31, "px", "corner score neighbourhood"},
-      {"spread_cell_px", field(&P::spread_cell_px), 0, 10000, "px",
-       "new corners go first to the grid cells of this side with the fewest points (0: "
-       "strongest in the image first, the paper)"},
+      {"spread_grid_columns", field(&P::spread_grid_columns), 0, 1000, "",
+       "new corners go first to the cells with the fewest points, on a grid of this many "
+       "columns of square cells (0: strongest in the image first, the paper)"},
       {"pyramid_levels", field(&P::pyramid_levels), 1, 10, "",
        "LK pyramid levels including full resolution (paper: 5)"},
       {"window_size_px", field(&P::window_size_px), 3, 51, "px",

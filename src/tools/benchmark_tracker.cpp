@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
   paper.window_size_px = 3;
   paper.forward_backward_check = paper.reanchor_on_search = false;
   paper.mask_existing = paper.reidentify = false;
-  paper.spread_cell_px = 0;
+  paper.spread_grid_columns = 0;
   printRow("paper (3x3 window, all off)", run(paper, walk, texture, vga, frames));
   TrackerParams paper_fb = paper;
   paper_fb.forward_backward_check = true;
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
   p.reidentify = false;
   printRow("without re-identification", run(p, walk, texture, vga, frames));
   p = all;
-  p.spread_cell_px = 0;
+  p.spread_grid_columns = 0;
   printRow("without spreading over cells", run(p, walk, texture, vga, frames));
   return 0;
 }

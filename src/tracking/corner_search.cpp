@@ -46,6 +46,11 @@ int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>&
   return static_cast<int>(before - kept);
 }
 
+double spreadCellPx(const cv::Size& image, int columns) {
+  if (columns <= 0 || image.empty()) return 0;
+  return static_cast<double>(image.width) / columns;
+}
+
 void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
                      const cv::Size& image, double cell_px, size_t keep) {
   if (cell_px <= 0 || image.empty()) {
@@ -126,7 +131,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   const int ask = rank ? 3 * wanted + 8 : wanted;
   // Spread over cells: the candidates come from the whole image (every corner above the
   // quality bar, up to 4 x max_features), then `ask` of them spread over the cells.
-  const bool spread = params.spread_cell_px > 0;
+  const double cell_px = spreadCellPx(full.size(), params.spread_grid_columns);
+  const bool spread = cell_px > 0;
   const int pool = spread ? std::max(ask, 4 * params.max_features) : ask;
   // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
   // the scores at the band's edge are those of the whole image.)
@@ -135,7 +141,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   if (corners.empty()) return corners;
   const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
   for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
-  if (spread) spreadOverCells(corners, live, full.size(), params.spread_cell_px, ask);
+  if (spread) spreadOverCells(corners, live, full.size(), cell_px, ask);
   // Score: the best of the pixel nearest the corner and its 8 neighbours (a corner found
   // by goodFeaturesToTrack is its neighbourhood's maximum).
   auto score = [&](const cv::Point2f& c, int block) {
@@ -182,7 +188,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                   corners.end());
   }
   // Ranked by score again above: spread again before the first `wanted` are kept.
-  if (spread) spreadOverCells(corners, live, full.size(), params.spread_cell_px, corners.size());
+  if (spread) spreadOverCells(corners, live, full.size(), cell_px, corners.size());
   keepApart(corners, live, params.min_distance_px, wanted);
   if (rank && static_cast<int>(corners.size()) < wanted) {
     // The coarse level holds fewer corners than wanted (fine texture fades there): the

@@ -125,7 +125,7 @@ TEST(FurnishedRoom, WheeledPath) {
   EXPECT_EQ(falsePlanes(run.eval), 0);
   EXPECT_TRUE(run.eval.split.empty());
   // The left wall: 18 points in 7 views, 0.1 m off, before the corners were spread over
-  // the image (TrackerParams::spread_cell_px); 53 points in 10 views since.
+  // the image (TrackerParams::spread_grid_columns); 53 points in 10 views since.
   for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
   EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);  // the bound

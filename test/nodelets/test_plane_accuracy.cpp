@@ -205,7 +205,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
     // Measured after the floor check (wheeled): camera 0.4 %, worst normal 1.4 deg (front
     // wall), worst distance 2.8 % (front wall); on the four other image-noise seeds
     // within 0.9 %, 2.1 deg and 3.5 % (docs/mapping.md); with the tracker's corner spread
-    // (spread_cell_px) 1.9 deg (left wall), 0.8 %. Humanoid: camera 0.3 %, normals 1.9
+    // (spread_grid_columns) 1.9 deg (left wall), 0.8 %. Humanoid: camera 0.3 %, normals 1.9
     // (front wall), 3.3 (left wall), 1.7 deg (floor), distances 6.9 % (front wall), 0.3 %,
     // 0.5 %: the 3 deg and 5 % are NOT met on the humanoid (its map rests on few
     // floor landmarks, mapped late); held to 4 deg and 8 % so that a worse start fails.

@@ -274,14 +274,23 @@ TEST(CornerSearch, AWeaklyTexturedHalfGetsCornersWhenSpread) {
     return std::count_if(corners.begin(), corners.end(),
                          [](const cv::Point2f& c) { return c.x > 320; });
   };
-  params.spread_cell_px = 0;  // strongest first: every corner on the strong half
+  params.spread_grid_columns = 0;  // strongest first: every corner on the strong half
   EXPECT_EQ(on_right(findCorners(image, pyramid[2], 1, {}, 20, params, buffers, &pyramid[1])), 0);
-  params.spread_cell_px = 80;
+  params.spread_grid_columns = 8;
   const std::vector<cv::Point2f> spread =
       findCorners(image, pyramid[2], 1, {}, 20, params, buffers, &pyramid[1]);
   EXPECT_EQ(spread.size(), 20u);
   EXPECT_GE(on_right(spread), 8);
   for (const auto& c : spread) EXPECT_LT(nearest(c, strong.corners), 0.3) << c;
+}
+
+// The grid has the same columns at any resolution: a camera of twice the resolution
+// gets cells of twice the side, not four times as many.
+TEST(CornerSearch, SpreadCellFollowsTheImageSize) {
+  EXPECT_EQ(spreadCellPx({640, 480}, 8), 80.0);
+  EXPECT_EQ(spreadCellPx({1280, 960}, 8), 160.0);
+  EXPECT_EQ(spreadCellPx({640, 480}, 0), 0.0);  // off: the paper's strongest first
+  EXPECT_EQ(spreadCellPx({}, 8), 0.0);
 }
 
 TEST(CornerSearch, SpreadOverTinyCellsIsBounded) {

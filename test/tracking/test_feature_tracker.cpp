@@ -143,7 +143,7 @@ TEST(FeatureTracker, PaperModeMatchesRedetectedCornersToLivePoints) {
   TrackerParams params;
   params.mask_existing = false;  // paper: a new search finds the same corners again
   params.reidentify = false;
-  params.spread_cell_px = 0;  // and takes the strongest (spread: 24 of 30 matched)
+  params.spread_grid_columns = 0;  // and takes the strongest (spread: 24 of 30 matched)
   FeatureTracker tracker(params);
   const auto hs = translations(11, kCentred, {0.5, 0.25});
   std::set<std::uint64_t> before;

@@ -24,6 +24,10 @@ int cornerSearchLevel(const cv::Size& image, int levels_built, const TrackerPara
 int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
               double min_distance_px, int wanted);
 
+// The side of spreadOverCells' squares for an image: `columns` across its width, so the
+// spread is the same at any resolution; 0 when columns is 0 (no spread).
+double spreadCellPx(const cv::Size& image, int columns);
+
 // Keeps at most `keep` of `corners` (strongest first), taking each next one from the
 // cell of a grid of cell_px squares over `image` that holds the fewest points so far
 // (live points and corners taken), the strongest there first: a weakly textured surface

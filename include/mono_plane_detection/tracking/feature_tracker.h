@@ -20,11 +20,12 @@ struct TrackerParams {
   double min_distance_px = 15.0;  // minimum spacing between corners
   double quality_level = 0.01;    // fraction of the strongest corner's score
   int block_size = 3;             // px, neighbourhood of the corner score
-  // Beyond the paper: new corners go first to the cells of this grid (px squares) that
-  // hold the fewest points, strongest first within a cell, instead of the strongest in the
-  // image: a weakly textured surface (a painted cabinet front) next to photographs gets
-  // corners too. 0: strongest first (the paper).
-  double spread_cell_px = 80.0;
+  // Beyond the paper: new corners go first to the cells of a grid that hold the fewest
+  // points, strongest first within a cell, instead of the strongest in the image: a
+  // weakly textured surface (a painted cabinet front) next to photographs gets corners
+  // too. The grid has this many columns of square cells whatever the image size
+  // (spreadCellPx: 80 px at 640 px wide, 160 px at 1280). 0: strongest first (the paper).
+  int spread_grid_columns = 8;
 
   // Pyramidal Lucas-Kanade (paper II-C).
   int pyramid_levels = 5;             // levels including full resolution (paper: 5)
