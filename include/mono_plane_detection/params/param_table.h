@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -25,6 +26,14 @@ using ParamField = std::variant<int*, double*, bool*, size_t*, unsigned*, std::s
 
 template <class P>
 struct ParamSpec {
+  // A table row: {name, field, min, max, unit, description} or with an old name (a
+  // constructor rather than an aggregate, so that rows without one need not name it).
+  ParamSpec(std::string name_, std::function<ParamField(P&)> field_, double min_, double max_,
+            std::string unit_, std::string description_, std::string old_name_ = "")
+      : name(std::move(name_)), field(std::move(field_)), min(min_), max(max_),
+        unit(std::move(unit_)), description(std::move(description_)),
+        old_name(std::move(old_name_)) {}
+
   std::string name;                       // ROS name and YAML key path ("pose/max_jump_m")
   std::function<ParamField(P&)> field;    // the struct member it sets
   double min = 0, max = 0;                // inclusive range (numbers only)
