@@ -131,9 +131,8 @@ cv::Vec3d nominalDown(const FloorParams& params) {
 
 }  // namespace
 
-FloorStart floorStart(const std::vector<cv::Point2d>& first,
-                      const std::vector<cv::Point2d>& second, double focal_px,
-                      const FloorParams& params) {
+FloorStart floorStart(const std::vector<cv::Point2d>& first, const std::vector<cv::Point2d>& second,
+                      double focal_px, const FloorParams& params) {
   FloorStart out;
   if (!(params.camera_height_m > 0)) {
     out.reason = "camera height unknown";

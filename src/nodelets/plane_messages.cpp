@@ -46,9 +46,9 @@ std::string targetMismatch(const Tracks& msg, const TargetParams& own) {
       !differs(msg.target_height_m, height))
     return {};
   std::ostringstream why;
-  why << "the tracker's start-up target (" << msg.target_type << ", " << msg.target_width_m
-      << " x " << msg.target_height_m << " m) is not this nodelet's (" << own.target_type
-      << ", " << width << " x " << height
+  why << "the tracker's start-up target (" << msg.target_type << ", " << msg.target_width_m << " x "
+      << msg.target_height_m << " m) is not this nodelet's (" << own.target_type << ", " << width
+      << " x " << height
       << " m): its corners are not used; set target/* once for both nodelets "
          "(config/target.yaml, launch arg target_config)";
   return why.str();

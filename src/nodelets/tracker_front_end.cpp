@@ -215,8 +215,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   counts_.searches += stats.searched ? 1 : 0;
   counts_.lost += stats.lost;
   counts_.tracked_now = static_cast<int>(tracker_.current().size());
-  out.tracks = toMessage(msg->header, image.size(), tracker_.current(), stats.searched,
-                         params_.target);
+  out.tracks =
+      toMessage(msg->header, image.size(), tracker_.current(), stats.searched, params_.target);
   return out;
 }
 

@@ -15,9 +15,9 @@
 
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
+#include "mono_plane_detection/params/param_table.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/tracking/stream_gaps.h"
-#include "mono_plane_detection/params/param_table.h"
 #include "mono_plane_detection/tracking/target_startup.h"
 
 namespace mono_plane_detection {

@@ -380,7 +380,8 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
     t.push_back({"detect_target", field(&P::detect_target), 0, 1, "",
                  "look for the start-up target (paper II-A) until found"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
-                 "a longer pause between images (and over 3 of their periods) is a tracking loss (start over)"});
+                 "a longer pause between images (and over 3 of their periods) is a tracking loss "
+                 "(start over)"});
     t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0.1, 1e6, "s",
                  "diagnostics WARN (with the reason) when images arrive this long without a "
                  "start-up target"});

@@ -111,7 +111,8 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
       // Insertion from the back (the list is short and sorted).
       if (best.size() == k) best.pop_back();
       best.push_back(key);
-      for (size_t m = best.size() - 1; m > 0 && key < best[m - 1]; --m) std::swap(best[m], best[m - 1]);
+      for (size_t m = best.size() - 1; m > 0 && key < best[m - 1]; --m)
+        std::swap(best[m], best[m - 1]);
       if (best.size() == k) worst2 = best.back().first;
     };
     if (cell_start_.empty()) {

@@ -48,8 +48,8 @@ constexpr size_t kVoteBlock = 32;
 // coefficients in locals, each point's outcome a 0/1 double summed after; a count in an
 // integer kept the compiler from vectorising: the vote's loops ran one point at a time).
 int votesInBlock(const cv::Matx33d& H, const PointArrays& p, size_t b0, size_t b1, double t2) {
-  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
-               h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1), h5 = H(1, 2),
+               h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
   const double* ax = p.ax.data() + b0;
   const double* ay = p.ay.data() + b0;
   const double* bx = p.bx.data() + b0;
@@ -252,8 +252,7 @@ void mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           if (!start) continue;
           HomographyPlane m;
           m.H = *start;
-          std::vector<int> union_inliers =
-              inliersAmong(m.H, view1, view2, in_union, union_px);
+          std::vector<int> union_inliers = inliersAmong(m.H, view1, view2, in_union, union_px);
           if (union_inliers.size() < 4 ||
               !refitAmong(m.H, union_inliers, view1, view2, in_union, params, union_px))
             continue;
@@ -592,8 +591,8 @@ Vote voteDominant(const std::vector<cv::Matx33d>& homographies,
   const double t2 = threshold_px * threshold_px;
   for (int h : order) {
     if (vote_bounds && !beats((*vote_bounds)[h], h)) continue;
-    const BlockCount count = countWhileItCanWin(homographies[h], points, t2,
-                                                [&](int reach) { return beats(reach, h); });
+    const BlockCount count =
+        countWhileItCanWin(homographies[h], points, t2, [&](int reach) { return beats(reach, h); });
     if (vote_bounds) (*vote_bounds)[h] = std::min((*vote_bounds)[h], count.votes);
     if (count.complete && beats(count.votes, h)) {
       vote.votes = count.votes;
@@ -833,8 +832,12 @@ class RepeatedVote {
  public:
   RepeatedVote(const std::vector<cv::Matx33d>& candidates, const std::vector<cv::Point2d>& view1,
                const std::vector<cv::Point2d>& view2, double threshold_px)
-      : candidates_(candidates), view1_(view1), view2_(view2), threshold_px_(threshold_px),
-        count_(candidates.size(), -1), bound_(candidates.size(), std::numeric_limits<int>::max()),
+      : candidates_(candidates),
+        view1_(view1),
+        view2_(view2),
+        threshold_px_(threshold_px),
+        count_(candidates.size(), -1),
+        bound_(candidates.size(), std::numeric_limits<int>::max()),
         retired_(candidates.size(), false) {}
 
   Vote next(const std::vector<bool>& active) {
@@ -908,9 +911,12 @@ std::vector<int> uniqueCorrespondences(const std::vector<cv::Point2d>& view1,
                                        std::vector<int>& dup_of) {
   std::vector<int> keep;
   dup_of.assign(view1.size(), -1);
-  auto key = [&](size_t i) { return std::make_tuple(view1[i].x, view1[i].y, view2[i].x, view2[i].y); };
+  auto key = [&](size_t i) {
+    return std::make_tuple(view1[i].x, view1[i].y, view2[i].x, view2[i].y);
+  };
   bool all_finite = true;
-  for (size_t i = 0; i < view1.size(); ++i) all_finite = all_finite && finite(view1[i]) && finite(view2[i]);
+  for (size_t i = 0; i < view1.size(); ++i)
+    all_finite = all_finite && finite(view1[i]) && finite(view2[i]);
   if (all_finite) {
     // The indices sorted by their four coordinates (ties by index): each run of equal
     // ones starts with its first copy. The same as the map below without a node per point

@@ -103,15 +103,16 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
   for (int it = 0; it < iterations; ++it) {
     const double cut = cut_sigmas * s.sigma_px;
     if (cut > bound) {  // the residuals in [bound, cut) join the sorted ones, after them
-      const auto mid = std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
+      const auto mid =
+          std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
       const size_t old = sorted.size();
       sorted.insert(sorted.end(), rest.begin(), mid);
       rest.erase(rest.begin(), mid);
       std::sort(sorted.begin() + static_cast<long>(old), sorted.end());
       bound = cut;
     }
-    const size_t in = static_cast<size_t>(
-        std::lower_bound(sorted.begin(), sorted.end(), cut) - sorted.begin());  // r < cut
+    const size_t in = static_cast<size_t>(std::lower_bound(sorted.begin(), sorted.end(), cut) -
+                                          sorted.begin());  // r < cut
     if (in == 0) return {};
     const double median = sorted[in / 2];
     const double next = median / median_in_sigmas;

@@ -271,7 +271,8 @@ int main(int argc, char** argv) {
       .integer("repeats", &repeats, 1, 10000, "scenes per plane row")
       .text("plot", &plot_path, "where to write the plot", "FILE.png")
       .flag("planes-only", &planes_only, "only the plane rows (no tracker, no target search)")
-      .integer("points", &only_points, 0, 100000, "only the plane row of this many points (0: all)");
+      .integer("points", &only_points, 0, 100000,
+               "only the plane row of this many points (0: all)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
   std::printf(

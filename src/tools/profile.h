@@ -1,7 +1,7 @@
 // Profiles for the command-line tools: the nodelets' YAML files (config/tracker.yaml,
-// config/planes.yaml, and config/target.yaml for both) with a robot's overlay on top (config/<nodelet>_<profile>.yaml),
-// read through the same parameter tables as the nodelets, so a tool runs with exactly
-// the settings `roslaunch ... profile:=humanoid` gives.
+// config/planes.yaml, and config/target.yaml for both) with a robot's overlay on top
+// (config/<nodelet>_<profile>.yaml), read through the same parameter tables as the nodelets, so a
+// tool runs with exactly the settings `roslaunch ... profile:=humanoid` gives.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -55,9 +55,9 @@ std::vector<std::string> applyYamlFile(const std::string& path, const ParamTable
   return errors;
 }
 
-// config/<nodelet>.yaml and config/target.yaml, then config/<nodelet>_<profile>.yaml over it ("default": no
-// overlay; "none": not even the base file, the core's defaults). A profile that is a path
-// to a .yaml file is read over the base file instead of an overlay.
+// config/<nodelet>.yaml and config/target.yaml, then config/<nodelet>_<profile>.yaml over it
+// ("default": no overlay; "none": not even the base file, the core's defaults). A profile that is a
+// path to a .yaml file is read over the base file instead of an overlay.
 template <class P>
 std::vector<std::string> loadProfile(const std::string& config_dir, const std::string& nodelet,
                                      const std::string& profile, const ParamTable<P>& table,

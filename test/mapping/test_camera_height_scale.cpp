@@ -5,8 +5,8 @@
 #include <opencv2/calib3d.hpp>
 #include <unordered_map>
 
-#include "mono_plane_detection/mapping/camera_height_scale.h"
 #include "mono_plane_detection/geometry/stats.h"
+#include "mono_plane_detection/mapping/camera_height_scale.h"
 #include "support/synthetic_tracks.h"
 
 using namespace mono_plane_detection;
@@ -256,9 +256,9 @@ TEST(CameraHeightScale, FloorFittedToAMapOfUnknownScale) {
   for (const cv::Vec3d& c : m.cameras) EXPECT_NEAR(s.apply(c)[1], 0.8, 0.01);
   // Absolute tolerances (the scaled start's) on this map: the floor's gate is three
   // times too narrow for its noise and the 6 deg cone misses it.
-  EXPECT_FALSE(fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30,
-                                   0.008)
-                   .ok);
+  EXPECT_FALSE(
+      fitFloorToLandmarks(m.points, m.sigma, m.cameras, cv::Vec3d(0, 1, 0), 6, 0.024, 30, 0.008)
+          .ok);
 }
 
 TEST(CameraHeightScale, TheCamerasPathFixesTheStripsTilt) {

@@ -197,8 +197,9 @@ TEST(PlaneAccuracy, RenderedSequence) {
   // height of motion after the start, 169 images placed; humanoid: once its floor is
   // mapped after the turn, 75 images placed).
   const bool humanoid_height = source == "camera_height" && g_trajectory == "humanoid";
-  EXPECT_GE(position_errors.size(),
-            humanoid_height ? 60u : source == "camera_height" ? 150u : 200u);
+  EXPECT_GE(position_errors.size(), humanoid_height             ? 60u
+                                    : source == "camera_height" ? 150u
+                                                                : 200u);
   EXPECT_LT(worst, 0.08 * truth.travelled_m);
   if (source == "camera_height") {
     // The bounds: camera < 5 % of the path, normal < 3 deg, distance < 5 %.

@@ -1,14 +1,12 @@
 // Profiles for the tools (src/tools/profile.h): the nodelets' YAML files read through the
 // parameter tables. The humanoid profile once reached run_pipeline as 2 of its 6 keys.
-#include "../../src/tools/profile.h"
-
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 
 #include <cerrno>
 #include <fstream>
 
+#include "../../src/tools/profile.h"
 #include "support/temp_path.h"
 
 using namespace mono_plane_detection;

@@ -22,7 +22,7 @@ TEST(GapCounter, PeriodIsTheSecondSmallestInterval) {
   GapCounter gaps;
   EXPECT_EQ(gaps.periodNs(), 0);
   gaps.add(kHz30);
-  gaps.add(kHz30 / 10);  // one short outlier (a duplicate-ish stamp) does not set it
+  gaps.add(kHz30 / 10);           // one short outlier (a duplicate-ish stamp) does not set it
   EXPECT_EQ(gaps.periodNs(), 0);  // three intervals needed
   gaps.add(2 * kHz30);
   EXPECT_EQ(gaps.periodNs(), kHz30);

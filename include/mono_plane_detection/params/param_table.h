@@ -15,8 +15,8 @@
 #include <variant>
 #include <vector>
 
-#include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
+#include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 
 namespace mono_plane_detection {
@@ -30,8 +30,12 @@ struct ParamSpec {
   // constructor rather than an aggregate, so that rows without one need not name it).
   ParamSpec(std::string name_, std::function<ParamField(P&)> field_, double min_, double max_,
             std::string unit_, std::string description_, std::string old_name_ = "")
-      : name(std::move(name_)), field(std::move(field_)), min(min_), max(max_),
-        unit(std::move(unit_)), description(std::move(description_)),
+      : name(std::move(name_)),
+        field(std::move(field_)),
+        min(min_),
+        max(max_),
+        unit(std::move(unit_)),
+        description(std::move(description_)),
         old_name(std::move(old_name_)) {}
 
   std::string name;                       // ROS name and YAML key path ("pose/max_jump_m")
