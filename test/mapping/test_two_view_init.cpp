@@ -103,84 +103,29 @@ std::optional<Pose> poseFromCorners(const std::array<cv::Point2d, 4>& c, const c
   return pose->map_from_camera;
 }
 
-struct Start {
-  Pose map_from_first, second_from_first;
-  std::array<cv::Point2d, 4> c1, c2;
-  std::vector<cv::Point2d> wall_a, wall_b;
-};
-
-Start startOf(const SyntheticTracks& world, const Pair& p) {
-  Start s;
-  s.map_from_first = world.truthMapFromCamera(0);
-  s.second_from_first = world.truthMapFromCamera(1.0).inverse() * s.map_from_first;
-  for (int k = 0; k < 4; ++k) {
-    s.c1[k] = p.a[p.target[k]];
-    s.c2[k] = p.b[p.target[k]];
-  }
-  const TargetPlaneHomography wall = targetPlaneHomography(p.a, p.b, p.target, world.camera.fx);
-  for (int i : wall.inliers) {
-    s.wall_a.push_back(p.a[i]);
-    s.wall_b.push_back(p.b[i]);
-  }
-  return s;
-}
-
 }  // namespace
 
 TEST(TwoViewInit, FourCornersSeenFaceOnLeaveTheTiltFree) {
   // The wheeled start: the A4 sheet 80 px wide from 2 m. 0.1 px on two corners (one
-  // side of the sheet longer) tilts the pose from the corners by more than a degree.
+  // side of the sheet longer) tilts the pose from the corners by nearly 3 degrees
+  // (the tilt's sigma grows with the distance squared: docs/mapping.md, "The wheeled
+  // start's tilt").
   const SyntheticTracks world("wheeled");
   const Pair p = pairOf(world, world.frame(0, 0.0), world.frame(1.0, 0.0));
-  Start s = startOf(world, p);
-  const cv::Matx33d truth = s.map_from_first.R;
-  const auto exact = poseFromCorners(s.c1, world.camera.K());
+  std::array<cv::Point2d, 4> corners;
+  for (int k = 0; k < 4; ++k) corners[k] = p.a[p.target[k]];
+  const cv::Matx33d truth = world.truthMapFromCamera(0).R;
+  const auto exact = poseFromCorners(corners, world.camera.K());
   ASSERT_TRUE(exact);
   EXPECT_LT(angleBetweenDeg(exact->R, truth), 0.05);
-  s.c1[0].x -= 0.1 / world.camera.fx;
-  s.c1[1].x += 0.1 / world.camera.fx;
-  const auto tilted = poseFromCorners(s.c1, world.camera.K());
+  corners[0].x -= 0.1 / world.camera.fx;
+  corners[1].x += 0.1 / world.camera.fx;
+  const auto tilted = poseFromCorners(corners, world.camera.K());
   ASSERT_TRUE(tilted);
   std::printf("tilt from the corners: exact %.3f deg, 0.1 px trapezoid %.3f deg\n",
               angleBetweenDeg(exact->R, truth), angleBetweenDeg(tilted->R, truth));
-  EXPECT_GT(angleBetweenDeg(tilted->R, truth), 1.0);
-  // The wall's tracks and the epipolar constraint over the 0.3 m of motion take it back
-  // (exact tracks here; on rendered images their noise leaves about 0.5 deg).
-  Pose map_from_first = *tilted, motion = s.second_from_first;
-  ASSERT_GT(s.wall_a.size(), 20u);
-  EXPECT_GE(refineStartOnTargetWall(s.c1, s.c2, s.wall_a, s.wall_b, p.a, p.b, TargetParams(),
-                                    1.0 / world.camera.fx, map_from_first, motion),
-            0);
-  EXPECT_LT(angleBetweenDeg(map_from_first.R, truth), 0.2);
-}
-
-TEST(TwoViewInit, RefinementReturnsExactPosesAndResistsAnOutlier) {
-  // Exact data: from poses tilted by 2 deg about the target the refinement returns the
-  // true ones; one wall track 20 px off (Huber) moves them by little.
-  const SyntheticTracks world("wheeled");
-  const Pair p = pairOf(world, world.frame(0, 0.0), world.frame(1.0, 0.0));
-  for (const bool outlier : {false, true}) {
-    Start s = startOf(world, p);
-    ASSERT_GT(s.wall_a.size(), 20u);
-    if (outlier) s.wall_b[0] += cv::Point2d(20.0 / world.camera.fx, 0);
-    cv::Matx33d tilt;
-    cv::Rodrigues(cv::Vec3d(2.0 * CV_PI / 180, 0, 0), tilt);
-    Pose guess{tilt * s.map_from_first.R, tilt * s.map_from_first.t};
-    Pose motion = s.second_from_first;
-    const double rms = refineStartOnTargetWall(s.c1, s.c2, s.wall_a, s.wall_b, p.a, p.b,
-                                               TargetParams(), 1.0 / world.camera.fx, guess,
-                                               motion);
-    EXPECT_GE(rms, 0);
-    EXPECT_LT(angleBetweenDeg(guess.R, s.map_from_first.R), outlier ? 0.3 : 0.01) << outlier;
-    EXPECT_LT(cv::norm(guess.t - s.map_from_first.t), outlier ? 0.01 : 1e-4) << outlier;
-    EXPECT_LT(cv::norm(motion.t - s.second_from_first.t), outlier ? 0.01 : 1e-4) << outlier;
-  }
-}
-
-TEST(TwoViewInit, RefinementRefusesAWallBehindTheCamera) {
-  const std::array<cv::Point2d, 4> c{};
-  Pose behind;  // identity: the target's plane passes through the camera
-  Pose motion{cv::Matx33d::eye(), cv::Vec3d(0, 0, 0.1)};
-  EXPECT_LT(refineStartOnTargetWall(c, c, {}, {}, {}, {}, TargetParams(), 0.002, behind, motion),
-            0);
+  EXPECT_GT(angleBetweenDeg(tilted->R, truth), 2.0);
+  // The start's averaged corners pass such errors on: the wall's homography that carries
+  // them back barely sees the tilt when the camera moves nearly along the wall's normal
+  // (t parallel to n leaves H = R + t n^T / d first-order blind to n).
 }

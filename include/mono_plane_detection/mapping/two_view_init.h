@@ -47,26 +47,6 @@ struct TwoViewInit {
   double parallax_deg = 0;            // median over the points
 };
 
-// Refines the start's two camera poses together: the target's corners (known 3D points)
-// in both images, every track on the target's wall (a plane through the corners:
-// symmetric transfer by the homography the two poses and that plane induce) and every
-// track's epipolar constraint (Sampson distance: it fixes the motion's direction, which
-// the wall's homography leaves free together with the wall's normal when the camera
-// moves towards the wall). Huber beyond `huber` (normalised units) except the corners.
-// map_from_first / second_from_first: the initial guess, replaced by the refinement.
-// Returns the final rms (normalised units), -1 when the guess is unusable.
-// Not used by the start: on the furnished room's wheeled start it takes the tilt from
-// 1.9 to 1.5 deg only, the tracks' own geometry agreeing with the tilt within their
-// noise (docs/mapping.md, "The wheeled start's tilt").
-double refineStartOnTargetWall(const std::array<cv::Point2d, 4>& corners_first,
-                               const std::array<cv::Point2d, 4>& corners_second,
-                               const std::vector<cv::Point2d>& wall_first,
-                               const std::vector<cv::Point2d>& wall_second,
-                               const std::vector<cv::Point2d>& epipolar_first,
-                               const std::vector<cv::Point2d>& epipolar_second,
-                               const TargetParams& target_params, double huber,
-                               Pose& map_from_first, Pose& second_from_first);
-
 // first/second: undistorted normalised coordinates of the same points in two images;
 // target: the indices of the target's four corners (TargetDetection order) among them;
 // first_corners: better (averaged) normalised corners of the first image, if known.
