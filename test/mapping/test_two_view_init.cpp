@@ -129,3 +129,49 @@ TEST(TwoViewInit, FourCornersSeenFaceOnLeaveTheTiltFree) {
   // them back barely sees the tilt when the camera moves nearly along the wall's normal
   // (t parallel to n leaves H = R + t n^T / d first-order blind to n).
 }
+
+TEST(TwoViewInit, MotionFromPlaneGivesTheTrueMotion) {
+  const SyntheticTracks world("wheeled");
+  const Pair p = pairOf(world, world.frame(0, 0.0), world.frame(1.0, 0.0));
+  const TargetPlaneHomography wall = targetPlaneHomography(p.a, p.b, p.target, world.camera.fx);
+  ASSERT_TRUE(wall.ok);
+  const Pose first_from_map = world.truthMapFromCamera(0).inverse();
+  const cv::Vec3d n = -(first_from_map.R * cv::Vec3d(0, 0, 1));
+  const Pose motion = motionFromPlane(wall.H, n, n.dot(first_from_map.t));
+  const Pose truth = world.truthMapFromCamera(1.0).inverse() * world.truthMapFromCamera(0);
+  EXPECT_LT(angleBetweenDeg(motion.R, truth.R), 0.01);
+  EXPECT_LT(cv::norm(motion.t - truth.t), 1e-3);
+}
+
+TEST(TwoViewInit, NearestRotationOfASumIsTheMean) {
+  cv::Matx33d a, b, mid;
+  cv::Rodrigues(cv::Vec3d(0.02, 0, 0), a);
+  cv::Rodrigues(cv::Vec3d(-0.02, 0.01, 0), b);
+  cv::Rodrigues(cv::Vec3d(0, 0.005, 0), mid);
+  const cv::Matx33d R = nearestRotation(a + b);
+  EXPECT_NEAR(cv::determinant(R), 1.0, 1e-12);
+  EXPECT_LT(angleBetweenDeg(R, mid), 0.01);
+  EXPECT_LT(angleBetweenDeg(nearestRotation(-1.0 * cv::Matx33d::eye() + 2.0 * a), a), 90.0);
+}
+
+TEST(TwoViewInit, PoseFromCornersWithAKnownRotation) {
+  // With the true orientation, the position from the corners is exact; with the
+  // orientation 1 deg off it moves by about that angle times the distance, not more.
+  const SyntheticTracks world("wheeled");
+  const Pair p = pairOf(world, world.frame(0, 0.0), world.frame(1.0, 0.0));
+  std::array<cv::Point2d, 4> corners;
+  for (int k = 0; k < 4; ++k) corners[k] = p.a[p.target[k]];
+  const Pose truth = world.truthMapFromCamera(0);
+  const auto exact = poseFromCornersWithRotation(corners, truth.R, TargetParams());
+  ASSERT_TRUE(exact);
+  EXPECT_LT(cv::norm(exact->t - truth.t), 1e-6);
+  cv::Matx33d tilt;
+  cv::Rodrigues(cv::Vec3d(CV_PI / 180, 0, 0), tilt);
+  const auto off = poseFromCornersWithRotation(corners, tilt * truth.R, TargetParams());
+  ASSERT_TRUE(off);
+  EXPECT_LT(cv::norm(off->t - truth.t), 2.0 * CV_PI / 180 * cv::norm(truth.t));
+  // Turned away from the target: the corners would be behind the camera.
+  cv::Matx33d away;
+  cv::Rodrigues(cv::Vec3d(0, CV_PI, 0), away);
+  EXPECT_FALSE(poseFromCornersWithRotation(corners, away * truth.R, TargetParams()));
+}
