@@ -2,9 +2,10 @@
 // own tilt only to a few degrees, and a tilted map puts every landmark in the wrong
 // place. So the first image's target corners are averaged over many images (each
 // image's corners carried back by the homography of the target's wall, estimated from
-// all tracks on it); the pose from those corners fixes map frame and scale, and the same
-// wall homography gives the camera's motion to the later image, from which all tracks
-// are triangulated. ROS-free.
+// all tracks on it); the pose from those corners fixes map frame and scale (its
+// orientation, when the caller has a better one, e.g. each image's own pose averaged:
+// first_rotation), and the same wall homography gives the camera's motion to the later
+// image, from which all tracks are triangulated. ROS-free.
 #pragma once
 
 #include <array>
