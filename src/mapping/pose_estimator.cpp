@@ -384,12 +384,15 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
                                                       const std::vector<cv::Point2d>& normalized) {
   // No pose is given out before the start succeeds: from one image the small target
   // places the camera only to 0.1-0.3 m (its tilt is poorly defined, two_view_init.h).
-  if (!targetPose(frame)) {
+  const std::optional<PoseEstimate> own = targetPose(frame);
+  if (!own) {
     first_view_.reset();  // the start needs the whole target in both views
     return {};
   }
   if (!first_view_) {
     first_view_ = firstView(frame, normalized);
+    first_view_->rotation_sum = own->map_from_camera.R;
+    first_view_->rotation_count = 1;
     return {};
   }
   std::unordered_map<std::uint64_t, size_t> in_first;
@@ -411,6 +414,8 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
   // Start again from this image when too few of the first view's tracks survive.
   if (!target_in_both || ids.size() * 2 < first_view_->ids.size()) {
     first_view_ = firstView(frame, normalized);
+    first_view_->rotation_sum = own->map_from_camera.R;
+    first_view_->rotation_count = 1;
     return {};
   }
   const TargetPlaneHomography wall =
@@ -425,8 +430,34 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
   }
   std::array<cv::Point2d, 4> corners;
   for (int k = 0; k < 4; ++k) corners[k] = first_view_->corner_sum[k] / first_view_->corner_count;
-  const TwoViewInit init =
-      initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view, corners);
+  if (wall.ok) {
+    // This image's orientation from its own corners, carried back to the first view by
+    // the relative rotation (the wall's homography with the first view's plane so far).
+    // Seen face-on from 2 m, each image's corners fix the tilt only to 1-4 deg, and
+    // carried back as corners they take on the homography's error in exactly the tilt;
+    // as orientations their errors average out (docs/mapping.md, "The wheeled start's
+    // tilt").
+    TargetDetection d;
+    d.found = true;
+    for (int k = 0; k < 4; ++k)
+      d.corners[k] = cv::Point2f(static_cast<float>(corners[k].x), static_cast<float>(corners[k].y));
+    const auto first_pose = cameraPoseFromTarget(d, cv::Matx33d::eye(), cv::Mat(), target_);
+    if (first_pose) {
+      const Pose first_from_map = first_pose->map_from_camera.inverse();
+      const cv::Vec3d n = -(first_from_map.R * cv::Vec3d(0, 0, 1));
+      const double dist = n.dot(first_from_map.t);
+      if (dist > 0) {
+        const Pose now_from_first = motionFromPlane(wall.H, n, dist);
+        first_view_->rotation_sum += own->map_from_camera.R * now_from_first.R;
+        ++first_view_->rotation_count;
+      }
+    }
+  }
+  std::optional<cv::Matx33d> rotation;
+  if (first_view_->rotation_count > 1)
+    rotation = nearestRotation(first_view_->rotation_sum);
+  const TwoViewInit init = initialiseFromTwoViews(a, b, target, K_(0, 0), target_,
+                                                  params_.two_view, corners, rotation);
   if (!init.ok) return {};
   first_view_.reset();
   placeStartLandmarks(frame, ids, b, init.points, init.points_map, init.parallax_deg,

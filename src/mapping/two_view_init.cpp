@@ -14,8 +14,9 @@ cv::Vec3d rayOf(const cv::Point2d& n) { return cv::Vec3d(n.x, n.y, 1.0); }
 
 cv::Vec3d normalised(const cv::Vec3d& v) { return v / cv::norm(v); }
 
-// second_from_first given the plane's homography H ~ R + t n^T / d (first-camera plane
-// n . x = d, n away from the camera): directions in the plane move with R alone.
+}  // namespace
+
+// Directions in the plane move with R alone.
 Pose motionFromPlane(cv::Matx33d H, const cv::Vec3d& n, double d) {
   if (cv::determinant(H) < 0) H = -H;
   const cv::Vec3d helper = std::abs(n[0]) < 0.9 ? cv::Vec3d(1, 0, 0) : cv::Vec3d(0, 1, 0);
@@ -33,7 +34,36 @@ Pose motionFromPlane(cv::Matx33d H, const cv::Vec3d& n, double d) {
   return {R, t};
 }
 
-}  // namespace
+cv::Matx33d nearestRotation(const cv::Matx33d& M) {
+  cv::Mat W, U, Vt;
+  cv::SVD::compute(cv::Mat(M), W, U, Vt);
+  cv::Mat D = cv::Mat::eye(3, 3, CV_64F);
+  D.at<double>(2, 2) = cv::determinant(U * Vt) < 0 ? -1 : 1;
+  return cv::Matx33d(cv::Mat(U * D * Vt));
+}
+
+std::optional<Pose> poseFromCornersWithRotation(const std::array<cv::Point2d, 4>& corners,
+                                                const cv::Matx33d& R,
+                                                const TargetParams& target_params) {
+  // Each corner's ray u (camera frame) is parallel to R^T (X - c): u x R^T c = u x R^T X.
+  const std::array<cv::Point3d, 4> X = targetCornersInMap(target_params);
+  cv::Matx33d A = cv::Matx33d::zeros();
+  cv::Vec3d b(0, 0, 0);
+  for (int k = 0; k < 4; ++k) {
+    const cv::Vec3d u = normalised(rayOf(corners[k]));
+    const cv::Matx33d ux(0, -u[2], u[1], u[2], 0, -u[0], -u[1], u[0], 0);
+    const cv::Matx33d M = ux * R.t();
+    A += M.t() * M;
+    b += M.t() * (M * cv::Vec3d(X[k].x, X[k].y, X[k].z));
+  }
+  cv::Vec3d c;
+  if (!cv::solve(A, b, c, cv::DECOMP_CHOLESKY)) return std::nullopt;
+  const Pose map_from_camera{R, c};
+  for (int k = 0; k < 4; ++k)
+    if (map_from_camera.inverse().apply(cv::Vec3d(X[k].x, X[k].y, X[k].z))[2] <= 0)
+      return std::nullopt;
+  return map_from_camera;
+}
 
 TargetPlaneHomography targetPlaneHomography(const std::vector<cv::Point2d>& first,
                                             const std::vector<cv::Point2d>& second,
@@ -88,7 +118,8 @@ TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
                                    const std::vector<cv::Point2d>& second,
                                    const std::array<int, 4>& target, double focal_px,
                                    const TargetParams& target_params, const TwoViewParams& params,
-                                   const std::optional<std::array<cv::Point2d, 4>>& first_corners) {
+                                   const std::optional<std::array<cv::Point2d, 4>>& first_corners,
+                                   const std::optional<cv::Matx33d>& first_rotation) {
   TwoViewInit out;
   const int n = static_cast<int>(first.size());
   if (n < params.min_inliers || second.size() != first.size()) {
@@ -114,6 +145,12 @@ TwoViewInit initialiseFromTwoViews(const std::vector<cv::Point2d>& first,
     return out;
   }
   out.map_from_first = start->map_from_camera;
+  if (first_rotation) {
+    std::array<cv::Point2d, 4> corners;
+    for (int k = 0; k < 4; ++k) corners[k] = first_corners ? (*first_corners)[k] : first[target[k]];
+    const auto placed = poseFromCornersWithRotation(corners, *first_rotation, target_params);
+    if (placed) out.map_from_first = *placed;
+  }
   const Pose first_from_map = out.map_from_first.inverse();
   const cv::Vec3d toward_plane =
       -(first_from_map.R * cv::Vec3d(0, 0, 1));  // map z faces the camera

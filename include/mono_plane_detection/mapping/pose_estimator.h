@@ -156,6 +156,10 @@ class PoseEstimator {
     // The tracks' points in this view's frame (metres) by each of those images' floor.
     std::vector<std::unordered_map<std::uint64_t, cv::Vec3d>> floor_points{};
     std::vector<cv::Vec3d> floor_downs{};
+    // Its orientation (map_from_camera.R) by each image's own corners, carried back by
+    // the relative rotation: summed, projected onto a rotation at the start.
+    cv::Matx33d rotation_sum = cv::Matx33d::zeros();
+    int rotation_count = 0;
   };
   FirstView firstView(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized) const;
 
