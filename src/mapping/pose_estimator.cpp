@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/plane_fit.h"
 #include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
@@ -13,10 +14,6 @@ namespace {
 cv::Vec3d unitRay(const Pose& map_from_camera, const cv::Point2d& n) {
   const cv::Vec3d r = map_from_camera.R * cv::Vec3d(n.x, n.y, 1.0);
   return r / cv::norm(r);
-}
-
-double angleDeg(const cv::Vec3d& a, const cv::Vec3d& b) {
-  return std::acos(std::max(-1.0, std::min(1.0, a.dot(b)))) * 180.0 / CV_PI;
 }
 
 cv::Matx34d cameraFromMap(const Pose& map_from_camera) {
@@ -241,7 +238,7 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
                                 p.min_check_points, p.check_camera_sigma * p.camera_height_m);
   if (check.unscaled) {
     // No start to undo: it waits for the floor landmarks (the camera's loss undoes it).
-    if (!fit.ok || angleDeg(fit.up, check.start_up) > p.max_floor_angle_deg) {
+    if (!fit.ok || normalAngleDeg(fit.up, check.start_up) > p.max_floor_angle_deg) {
       floor_reason_ = "started up to scale, waiting for the map's floor: " +
                       (fit.ok ? std::string("too steep") : fit.reason);
       return false;
@@ -272,7 +269,7 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   }
   const Similarity s =
       floorCorrection(fit, check.cameras, check.cameras.front(), p.camera_height_m);
-  if (!check.unscaled && (angleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
+  if (!check.unscaled && (normalAngleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
                           std::abs(s.scale - 1) > p.max_check_scale)) {
     undoFloorStart("the start's floor disagreed with the map's floor: started again");
     return false;
@@ -544,8 +541,8 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
     // 2 deg and its scale by 5 %; the humanoid's chance planes change by more).
     FirstView& view = floor_views_[v];
     if (f.ok) {
-      const bool same = view.floor_count > 0 &&
-                        angleDeg(view.floor_down, f.down) < params_.floor.max_floor_change_deg;
+      const bool same = view.floor_count > 0 && normalAngleDeg(view.floor_down, f.down) <
+                                                    params_.floor.max_floor_change_deg;
       view.floor_count = same ? view.floor_count + 1 : 1;
       view.floor_down = f.down;
       if (!same) {
@@ -666,8 +663,8 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
       continue;
     }
     if (l.fixed) continue;
-    const double parallax = angleDeg(unitRay(l.anchor_pose, l.anchor_normalized),
-                                     unitRay(map_from_camera, normalized[i]));
+    const double parallax = normalAngleDeg(unitRay(l.anchor_pose, l.anchor_normalized),
+                                           unitRay(map_from_camera, normalized[i]));
     if (parallax < params_.min_parallax_deg) continue;
     if (l.triangulated && parallax < params_.retriangulate_factor * l.parallax_deg) continue;
     const auto p = mono_plane_detection::triangulate(cameraFromMap(l.anchor_pose), P2,
