@@ -124,6 +124,17 @@ std::optional<Motion> measureMotion(const std::vector<cv::Point2d>& first,
   return m;
 }
 
+// Why two views cannot start the map (camera height unknown, too few tracks), "" when
+// they can: the floor start's and the up-to-scale start's common checks.
+std::string startInputError(const std::vector<cv::Point2d>& first,
+                            const std::vector<cv::Point2d>& second, const FloorParams& params,
+                            int needed) {
+  if (!(params.camera_height_m > 0)) return "camera height unknown";
+  if (second.size() != first.size() || static_cast<int>(first.size()) < needed)
+    return "too few tracks";
+  return {};
+}
+
 cv::Vec3d nominalDown(const FloorParams& params) {
   const double pitch = params.pitch_down_deg * CV_PI / 180.0;
   return cv::Vec3d(0, std::cos(pitch), std::sin(pitch));  // x right, y down, z ahead
@@ -134,15 +145,8 @@ cv::Vec3d nominalDown(const FloorParams& params) {
 FloorStart floorStart(const std::vector<cv::Point2d>& first, const std::vector<cv::Point2d>& second,
                       double focal_px, const FloorParams& params) {
   FloorStart out;
-  if (!(params.camera_height_m > 0)) {
-    out.reason = "camera height unknown";
-    return out;
-  }
-  const int n = static_cast<int>(first.size());
-  if (static_cast<int>(second.size()) != n || n < std::max(8, params.min_inliers)) {
-    out.reason = "too few tracks";
-    return out;
-  }
+  out.reason = startInputError(first, second, params, std::max(8, params.min_inliers));
+  if (!out.reason.empty()) return out;
   std::optional<Motion> motion =
       measureMotion(first, second, focal_px, params.max_error_px, out.reason);
   if (!motion) return out;
@@ -288,16 +292,9 @@ FloorStart unscaledStart(const std::vector<cv::Point2d>& first,
                          const std::vector<cv::Point2d>& second, double focal_px,
                          const FloorParams& params) {
   FloorStart out;
-  if (!(params.camera_height_m > 0)) {
-    out.reason = "camera height unknown";
-    return out;
-  }
-  const int n = static_cast<int>(first.size());
   const int needed = std::max(8, params.min_check_points);
-  if (static_cast<int>(second.size()) != n || n < needed) {
-    out.reason = "too few tracks";
-    return out;
-  }
+  out.reason = startInputError(first, second, params, needed);
+  if (!out.reason.empty()) return out;
   std::optional<Motion> motion =
       measureMotion(first, second, focal_px, params.max_error_px, out.reason, true);
   if (!motion) return out;

@@ -386,10 +386,14 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
     first_view_.reset();  // the start needs the whole target in both views
     return {};
   }
-  if (!first_view_) {
+  // This image as the start's first view, its own orientation the first of the average.
+  auto startFromHere = [&] {
     first_view_ = firstView(frame, normalized);
     first_view_->rotation_sum = own->map_from_camera.R;
     first_view_->rotation_count = 1;
+  };
+  if (!first_view_) {
+    startFromHere();
     return {};
   }
   std::unordered_map<std::uint64_t, size_t> in_first;
@@ -410,9 +414,7 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
       std::all_of(target.begin(), target.end(), [](int i) { return i >= 0; });
   // Start again from this image when too few of the first view's tracks survive.
   if (!target_in_both || ids.size() * 2 < first_view_->ids.size()) {
-    first_view_ = firstView(frame, normalized);
-    first_view_->rotation_sum = own->map_from_camera.R;
-    first_view_->rotation_count = 1;
+    startFromHere();
     return {};
   }
   const TargetPlaneHomography wall =
