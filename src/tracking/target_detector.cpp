@@ -692,8 +692,20 @@ std::optional<TargetPose> cameraPoseFromTarget(const TargetDetection& detection,
   const std::vector<cv::Point3d> object(map_corners.begin(), map_corners.end());
   const std::vector<cv::Point2d> image(detection.corners.begin(), detection.corners.end());
   cv::Vec3d rvec, tvec;
-  if (!cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false, cv::SOLVEPNP_IPPE)) {
-    return std::nullopt;
+  const auto finite = [&] {
+    return cv::checkRange(rvec) && cv::checkRange(tvec);
+  };
+  // IPPE returns NaN for some nearly frontal views with a little corner noise (its
+  // rotation takes a square root of a rounding-negative number): solved again by the
+  // iterative solver, whose planar start is a homography, rather than refused.
+  if (!cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false,
+                    cv::SOLVEPNP_IPPE) ||
+      !finite()) {
+    if (!cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false,
+                      cv::SOLVEPNP_ITERATIVE) ||
+        !finite()) {
+      return std::nullopt;
+    }
   }
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);

@@ -101,8 +101,9 @@ struct TargetPose {
   double reprojection_error_px = 0;  // rms over the 4 corners
 };
 
-// solvePnP with the planar IPPE solver. Nothing when the intrinsics are unusable
-// (non-positive or non-finite focal length) or the solver fails.
+// solvePnP with the planar IPPE solver (the iterative solver where IPPE gives no finite
+// pose). Nothing when the intrinsics are unusable (non-positive or non-finite focal
+// length) or no solver gives a finite pose.
 std::optional<TargetPose> cameraPoseFromTarget(const TargetDetection& detection,
                                                const cv::Matx33d& K, const cv::Mat& distortion,
                                                const TargetParams& params = TargetParams());
