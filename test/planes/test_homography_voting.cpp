@@ -190,7 +190,9 @@ TEST(SegmentPlanes, PlanesAreSortedAndConsistentWithLabels) {
   const auto r = segmentPlanes(scene.view1, scene.view2);
   ASSERT_FALSE(r.planes.empty());
   for (size_t k = 0; k < r.planes.size(); ++k) {
-    if (k > 0) EXPECT_GE(r.planes[k - 1].inliers.size(), r.planes[k].inliers.size());
+    if (k > 0) {
+      EXPECT_GE(r.planes[k - 1].inliers.size(), r.planes[k].inliers.size());
+    }
     for (int i : r.planes[k].inliers) EXPECT_EQ(r.labels[i], static_cast<int>(k) + 1);
     EXPECT_LT(r.planes[k].rms_error_px, 2.0);
     EXPECT_NEAR(r.planes[k].score, double(r.planes[k].inliers.size()) / scene.view1.size(), 1e-12);
@@ -463,7 +465,9 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
     const PlaneSegmentation r = segmentPlanes(c.view1, c.view2, params);
     ASSERT_GE(r.planes.size(), 1u) << "seed " << seed;
     // (Seed 3 ends with the floor only: F from one plane is undetermined.)
-    if (r.planes.size() > 1) EXPECT_TRUE(r.epipolar_checked) << "seed " << seed;
+    if (r.planes.size() > 1) {
+      EXPECT_TRUE(r.epipolar_checked) << "seed " << seed;
+    }
     size_t floor = 0;
     double floor_induced = 1e9;
     for (size_t k = 0; k < r.planes.size(); ++k) {

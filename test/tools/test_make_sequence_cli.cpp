@@ -117,7 +117,7 @@ TEST(MakeSequenceCli, TargetsBackgroundsLayoutAndTextures) {
     EXPECT_NE(text.find(c.yaml_has), std::string::npos) << c.args;
   }
   // Bad usage: a table in the bare room, a folder without images, unknown values.
-  for (const std::string bad :
+  for (const std::string& bad :
        {std::string("--target-on table"), std::string("--textures /no/such/folder"),
         std::string("--target poster"), std::string("--background pink"),
         std::string("--layout castle"), std::string("--aruco-id 50")}) {

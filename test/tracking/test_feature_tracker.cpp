@@ -400,7 +400,9 @@ TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
       EXPECT_LT(p.uv.y, part * third + 1.0f) << "image " << k << ", part " << part;
     }
     parts_seen[part] += fresh > 0;
-    if (part == 3) EXPECT_GE(points.size(), 140u) << "image " << k;  // refilled
+    if (part == 3) {
+      EXPECT_GE(points.size(), 140u) << "image " << k;  // refilled
+    }
   }
   EXPECT_GE(parts_seen[1], 2);
   EXPECT_GE(parts_seen[2], 2);
