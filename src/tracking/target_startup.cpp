@@ -82,7 +82,8 @@ void TargetStartup::followTarget(const cv::Mat& gray, FeatureTracker& tracker) {
       }
   if (alive < 4) return;  // a corner lost: the target is leaving the view or hidden
   // The region: the tracked quadrilateral (undistorted, where the sides are straight) with
-  // a margin for the surround the detector measures its sides against.
+  // a margin for the surround the detector measures its sides against (an eighth of the
+  // size: a quarter found the same corners at 1.25x the time, benchmark_suite).
   const bool undistort = !D_.empty();
   std::vector<cv::Point2f> where(tracked.begin(), tracked.end());
   if (undistort) {
@@ -94,7 +95,7 @@ void TargetStartup::followTarget(const cv::Mat& gray, FeatureTracker& tracker) {
       cv::undistortPoints(raw, where, K_, D_, cv::noArray(), K_);
   }
   const cv::Rect box = cv::boundingRect(where);  // integer, enclosing
-  const int margin = std::max(12, std::max(box.width, box.height) / 4);
+  const int margin = std::max(12, std::max(box.width, box.height) / 8);
   cv::Rect roi(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin);
   roi &= cv::Rect(0, 0, gray.cols, gray.rows);
   if (roi.width < 16 || roi.height < 16) return;
