@@ -197,6 +197,8 @@ TEST(TargetStartup, DriftedTargetTracksAreReanchoredToTheDetectedCorners) {
       worst_drifted = std::max(worst_drifted, cv::norm(cv::Point2d(tracks[k].uv) - truth[k]));
     EXPECT_FALSE(startup.process(view, tracker));  // confirmed once only
     EXPECT_TRUE(startup.reanchored()) << "image " << image;
+    // The largest move: the 1.5 px pushed onto corner 2, give or take LK's error.
+    EXPECT_NEAR(startup.lastReanchorShiftPx(), 1.5, 0.3) << "image " << image;
     tracks = targetTracks(tracker);
     // The corners a search of the whole image finds (the crop's noise estimate differs).
     const TargetDetection whole = detectTarget(view, TargetParams(), camera.fx);
@@ -247,6 +249,7 @@ TEST(TargetStartup, NoReanchorWhenTheDetectionDisagreesOrFails) {
     before = targetTracks(tracker);
     startup.process(view, tracker);
     EXPECT_EQ(startup.reanchored(), redetect);
+    if (redetect) EXPECT_NEAR(startup.lastReanchorShiftPx(), 1.0, 0.1);  // net push left
     after = targetTracks(tracker);
     EXPECT_EQ(after[0].uv != before[0].uv, redetect);
     // No target in the image searched (the region blank): nothing moves.
