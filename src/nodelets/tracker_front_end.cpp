@@ -210,6 +210,9 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
           << "; planes stay in image space until one is seen";
       out.warnings.push_back({"target timeout", why.str()});
     }
+  } else if (params_.detect_target) {
+    // Confirmed: found again around its tracked corners, which then do not drift.
+    target_startup_.process(image, tracker_, focal_px_, principal_px_);
   }
   const TrackerFrameStats& stats = tracker_.lastStats();
   counts_.searches += stats.searched ? 1 : 0;

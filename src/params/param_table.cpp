@@ -155,6 +155,9 @@ const ParamTable<TargetParams>& targetParamTable() {
        "consecutive images with consistently tracked corners before the target fixes the map"},
       {"confirm_tolerance_px", field(&P::confirm_tolerance_px), 0.01, 100, "px",
        "detected vs Lucas-Kanade-tracked corner, largest distance, to count as consistent"},
+      {"redetect_tracked", field(&P::redetect_tracked), 0, 1, "",
+       "after confirmation, find the target again in each image and move its tracked corners "
+       "onto the detected ones (same ids) when they agree within confirm_tolerance_px"},
   };
   return table;
 }

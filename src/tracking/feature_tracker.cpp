@@ -157,6 +157,21 @@ std::vector<std::uint64_t> FeatureTracker::addPoints(const std::vector<cv::Point
   return ids;
 }
 
+int FeatureTracker::movePoints(const std::vector<std::uint64_t>& ids,
+                               const std::vector<cv::Point2f>& uv) {
+  int moved = 0;
+  for (size_t k = 0; k < ids.size() && k < uv.size(); ++k) {
+    if (!inside(uv[k], image_size_)) continue;
+    for (TrackedPoint& p : current_)
+      if (p.id == ids[k]) {
+        p.uv = uv[k];
+        ++moved;
+        break;
+      }
+  }
+  return moved;
+}
+
 void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
   if (previous_.empty()) return;

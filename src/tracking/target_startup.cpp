@@ -1,6 +1,7 @@
 #include "mono_plane_detection/tracking/target_startup.h"
 
 #include <algorithm>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -14,6 +15,10 @@ void TargetStartup::reset() {
   consecutive_ = 0;
   previous_.release();
   last_ = TargetDetection();
+  corner_ids_.clear();
+  reanchored_ = false;
+  reanchored_images_ = 0;
+  last_shift_px_ = 0;
 }
 
 void TargetStartup::setLens(const cv::Matx33d& K, const cv::Mat& D, bool fisheye) {
@@ -54,19 +59,93 @@ bool toRawPixels(std::array<cv::Point2f, 4>& corners, const cv::Matx33d& K, cons
 
 }  // namespace
 
+void TargetStartup::ensureMaps(const cv::Size& size) {
+  if (D_.empty() || map_size_ == size) return;
+  if (fisheye_)
+    cv::fisheye::initUndistortRectifyMap(K_, D_, cv::Matx33d::eye(), K_, size, CV_16SC2, map1_,
+                                         map2_);
+  else
+    cv::initUndistortRectifyMap(K_, D_, cv::noArray(), K_, size, CV_16SC2, map1_, map2_);
+  map_size_ = size;
+}
+
+void TargetStartup::followTarget(const cv::Mat& gray, FeatureTracker& tracker) {
+  reanchored_ = false;
+  if (corner_ids_.size() != 4 || gray.empty()) return;
+  std::array<cv::Point2f, 4> tracked;
+  int alive = 0;
+  for (const TrackedPoint& p : tracker.current())
+    for (int k = 0; k < 4; ++k)
+      if (p.id == corner_ids_[k]) {
+        tracked[k] = p.uv;
+        ++alive;
+      }
+  if (alive < 4) return;  // a corner lost: the target is leaving the view or hidden
+  // The region: the tracked quadrilateral (undistorted, where the sides are straight) with
+  // a margin for the surround the detector measures its sides against (an eighth of the
+  // size: a quarter found the same corners at 1.25x the time, benchmark_suite).
+  const bool undistort = !D_.empty();
+  std::vector<cv::Point2f> where(tracked.begin(), tracked.end());
+  if (undistort) {
+    ensureMaps(gray.size());
+    std::vector<cv::Point2f> raw = where;
+    if (fisheye_)
+      cv::fisheye::undistortPoints(raw, where, K_, D_, cv::noArray(), K_);
+    else
+      cv::undistortPoints(raw, where, K_, D_, cv::noArray(), K_);
+  }
+  const cv::Rect box = cv::boundingRect(where);  // integer, enclosing
+  const int margin = std::max(12, std::max(box.width, box.height) / 8);
+  cv::Rect roi(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin);
+  roi &= cv::Rect(0, 0, gray.cols, gray.rows);
+  if (roi.width < 16 || roi.height < 16) return;
+  if (undistort)  // only the region: the maps give each of its pixels' raw position
+    cv::remap(gray, crop_, map1_(roi), map2_(roi), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  const cv::Mat search = undistort ? crop_ : gray(roi);
+  // No aspect check here: its focal length and principal point do not carry over to a
+  // crop, and the target is already known: four corners that each land within
+  // confirm_tolerance_px of a confirmed track are its corners.
+  TargetParams params = params_;
+  params.max_aspect_error = std::numeric_limits<double>::infinity();
+  TargetDetection again = detectConfiguredTarget(search, params);
+  if (!again.found) return;  // the tracks stay as they are
+  const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
+  for (auto& c : again.corners) c += offset;
+  if (undistort && !toRawPixels(again.corners, K_, D_, fisheye_, gray.size())) return;
+  // Each track to its nearest detected corner: four different ones, all close.
+  std::vector<cv::Point2f> detected(4);
+  std::array<bool, 4> used{};
+  double worst = 0;
+  for (int k = 0; k < 4; ++k) {
+    int best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < 4; ++j) {
+      const double d = cv::norm(again.corners[j] - tracked[k]);
+      if (d < best_d) {
+        best_d = d;
+        best = j;
+      }
+    }
+    if (used[best] || !(best_d <= params_.confirm_tolerance_px)) return;
+    used[best] = true;
+    detected[k] = again.corners[best];
+    worst = std::max(worst, best_d);
+  }
+  if (tracker.movePoints(corner_ids_, detected) != 4) return;
+  reanchored_ = true;
+  ++reanchored_images_;
+  last_shift_px_ = worst;
+}
+
 std::optional<TargetDetection> TargetStartup::process(const cv::Mat& gray, FeatureTracker& tracker,
                                                       double focal_px,
                                                       cv::Point2d principal_px) {
-  if (found_) return {};
-  const bool undistort = !D_.empty() && !gray.empty();
-  if (undistort && map_size_ != gray.size()) {
-    if (fisheye_)
-      cv::fisheye::initUndistortRectifyMap(K_, D_, cv::Matx33d::eye(), K_, gray.size(), CV_16SC2,
-                                           map1_, map2_);
-    else
-      cv::initUndistortRectifyMap(K_, D_, cv::noArray(), K_, gray.size(), CV_16SC2, map1_, map2_);
-    map_size_ = gray.size();
+  if (found_) {
+    if (params_.redetect_tracked) followTarget(gray, tracker);
+    return {};
   }
+  const bool undistort = !D_.empty() && !gray.empty();
+  if (undistort) ensureMaps(gray.size());
   if (undistort) {
     // Replicated, not black, beyond the raw image: a black fill would be a dark surround.
     cv::remap(gray, undistorted_, map1_, map2_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
@@ -110,7 +189,7 @@ std::optional<TargetDetection> TargetStartup::process(const cv::Mat& gray, Featu
     last_.reason = why.str();
     return {};
   }
-  tracker.addPoints({target.corners.begin(), target.corners.end()}, true);
+  corner_ids_ = tracker.addPoints({target.corners.begin(), target.corners.end()}, true);
   found_ = true;
   previous_.release();
   return target;

@@ -332,6 +332,35 @@ TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
   }
 }
 
+// movePoints (the re-detected target's corners): the point keeps its id and flags, is
+// tracked on from its new place; unknown ids and positions outside the image are skipped.
+TEST(FeatureTracker, MovedPointsKeepTheirIdsAndAreTrackedFromTheirNewPlace) {
+  FeatureTracker tracker;
+  const auto hs = translations(3, kCentred, {1.0, 0.5});
+  tracker.process(warpView(texture(), hs[0], kView));
+  ASSERT_GT(tracker.current().size(), 10u);
+  const TrackedPoint a = tracker.current()[3], b = tracker.current()[7];
+  // A point pushed 0.7 px off its corner, then brought back exactly: the truth.
+  const cv::Point2f off(0.5f, -0.5f);
+  ASSERT_EQ(tracker.movePoints({a.id, b.id}, {a.uv + off, b.uv}), 2);
+  const auto& moved = tracker.current();
+  EXPECT_EQ(moved[3].id, a.id);
+  EXPECT_EQ(moved[3].uv, a.uv + off);
+  EXPECT_EQ(moved[7].uv, b.uv);
+  EXPECT_EQ(tracker.movePoints({999999}, {{10.f, 10.f}}), 0);    // no such id
+  EXPECT_EQ(tracker.movePoints({a.id}, {{-5.f, 10.f}}), 0);       // outside the image
+  EXPECT_EQ(tracker.current()[3].uv, a.uv + off);
+  tracker.process(warpView(texture(), hs[1], kView));
+  for (const auto& p : tracker.current()) {
+    if (p.id != a.id) continue;
+    EXPECT_TRUE(p.is_tracked);
+    // Lucas-Kanade from the moved place: the offset carried (partly pulled back to
+    // the corner by the window), not the original track.
+    const cv::Point2d was = transfer(hs[1] * hs[0].inv(), cv::Point2d(a.uv));
+    EXPECT_GT(cv::norm(cv::Point2d(p.uv) - was), 0.1);
+  }
+}
+
 // Something moves in front of half of the scene: the points there cannot be followed,
 // Lucas-Kanade still converges somewhere on the new texture, and the forward-backward
 // check (its short pass from the image's median motion, then the full pass) must drop

@@ -119,6 +119,12 @@ class FeatureTracker {
   // Returns their ids. Call after process().
   std::vector<std::uint64_t> addPoints(const std::vector<cv::Point2f>& uv, bool target_corner);
 
+  // Moves live points of the image just processed (by id) to positions measured by other
+  // means (the start-up target re-detected: tracks that do not drift); they keep their
+  // ids and flags and are tracked on from there. Ids not live and positions outside the
+  // image are skipped. Returns how many moved. Call after process().
+  int movePoints(const std::vector<std::uint64_t>& ids, const std::vector<cv::Point2f>& uv);
+
   // Forgets every point and image; ids keep increasing so they are never reused.
   void reset();
 

@@ -39,6 +39,12 @@ struct TargetParams {
   // with where the tracker moved them before it fixes the map frame.
   int confirm_frames = 3;
   double confirm_tolerance_px = 2.0;  // detected vs tracked corner, largest distance
+  // After confirmation, while its four corners are tracked: the target is found again in
+  // each image (around the tracked corners) and the tracks are moved onto the detected
+  // corners, ids kept, when all four agree within confirm_tolerance_px. Lucas-Kanade
+  // alone drifts by tenths of a pixel, which tilts a small, distant target's pose by
+  // degrees (docs/start_up.md, "Re-detected corners").
+  bool redetect_tracked = true;
 };
 
 // Why a candidate (or an image) gave no target; the last stage the best candidate

@@ -4,11 +4,17 @@
 // so the plane stage can place the camera. One detection is not enough: a target fixes
 // the map frame only after params.confirm_frames consecutive images in which it is found
 // where Lucas-Kanade moved its corners from the image before (a chance quadrilateral in
-// texture does not stay put under the camera's motion). ROS-free.
+// texture does not stay put under the camera's motion). After that, while its four
+// corners are tracked (params.redetect_tracked), the target is found again in each image
+// in a small region around them, and the tracks are moved onto the detected sub-pixel
+// corners (ids kept) when all four agree: the corners the start averages are then
+// independent measurements, not Lucas-Kanade's drift. ROS-free.
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "mono_plane_detection/tracking/feature_tracker.h"
 #include "mono_plane_detection/tracking/target_detector.h"
@@ -19,8 +25,9 @@ class TargetStartup {
  public:
   explicit TargetStartup(const TargetParams& params = TargetParams()) : params_(params) {}
 
-  // Call after tracker.process(gray). Returns the detection on the image where the target
-  // is confirmed (once); nothing before and after. focal_px: 0 when unknown;
+  // Call after tracker.process(gray), on every image. Returns the detection on the image
+  // where the target is confirmed (once); nothing before and after (after, the tracked
+  // corners are re-anchored to the re-detected target). focal_px: 0 when unknown;
   // principal_px: negative for the image centre.
   std::optional<TargetDetection> process(const cv::Mat& gray, FeatureTracker& tracker,
                                          double focal_px = 0,
@@ -39,6 +46,11 @@ class TargetStartup {
   // The last image's detection (found or why not), for diagnostics.
   const TargetDetection& lastDetection() const { return last_; }
   int consecutive() const { return consecutive_; }  // images the candidate has been confirmed in
+  // After confirmation: whether the last image's target tracks were moved onto a
+  // re-detection, in how many images they were, and their largest move there (px).
+  bool reanchored() const { return reanchored_; }
+  int reanchoredImages() const { return reanchored_images_; }
+  double lastReanchorShiftPx() const { return last_shift_px_; }
 
  private:
   TargetParams params_;
@@ -46,6 +58,13 @@ class TargetStartup {
   int consecutive_ = 0;
   cv::Mat previous_;  // the image of the last detection, for Lucas-Kanade
   TargetDetection last_;
+  std::vector<std::uint64_t> corner_ids_;  // the tracker's ids of the corners, in order
+  bool reanchored_ = false;
+  int reanchored_images_ = 0;
+  double last_shift_px_ = 0;
+  cv::Mat crop_;  // the region searched after confirmation (undistorted when a lens is set)
+  void followTarget(const cv::Mat& gray, FeatureTracker& tracker);
+  void ensureMaps(const cv::Size& size);
   // The lens (setLens) and the undistortion maps for the last image size.
   cv::Matx33d K_ = cv::Matx33d::eye();
   cv::Mat D_;
