@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -433,8 +434,8 @@ SideCheck checkSides(const cv::Mat& gray, const Quad& q, double area, double sig
 // line (median) must stay under a quarter of the step across the side itself, and
 // within the noise: 3 sigmas. Measured on the development photos: sheets 0.00-0.05 of
 // their side's step, the TUM office impostors 0.3-2.6. Ends out of the image are not
-// judged (a sheet that fills the view has none to show). Returns the side (-1: none)
-// and its continuation's step over its own.
+// judged (a sheet that fills the view has none to show). Returns the corner past which
+// an edge goes on (-1: none) and that continuation's step over its side's.
 std::pair<int, double> continuingSide(const cv::Mat& gray, const Quad& q, double sigma) {
   cv::Point2f centre(0, 0);
   for (const auto& p : q) centre += p * 0.25f;
@@ -485,7 +486,7 @@ std::pair<int, double> continuingSide(const cv::Mat& gray, const Quad& q, double
       if (past.size() < samples / 2) continue;
       const double continued = std::abs(median(past));
       if (continued > std::max(0.25 * step, 3 * sigma) && continued / step > worst.second)
-        worst = {i, continued / step};
+        worst = {end ? (i + 1) % 4 : i, continued / step};
     }
   }
   return worst;
@@ -718,11 +719,14 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
     }
     Quad in_work;
     for (int i = 0; i < 4; ++i) in_work[i] = (*refined)[i] * static_cast<float>(scale);
-    if (const auto [side, fraction] = continuingSide(work, in_work, sigma); side >= 0) {
+    if (const auto [corner, fraction] = continuingSide(work, in_work, sigma); corner >= 0) {
+      // Where, in the image: a user at the robot sees which corner lines up with what.
       std::ostringstream why;
       why.precision(2);
-      why << "side " << side << "'s edge goes on past its corner with " << std::fixed << fraction
-          << " of its step (part of a larger pattern: a stripe, a box, a desk?)";
+      why << "an edge goes on past the corner at (" << std::fixed << std::setprecision(0)
+          << (*refined)[corner].x << ", " << (*refined)[corner].y << ") px with "
+          << std::setprecision(2) << fraction
+          << " of its step (part of something larger: a stripe, a box, a table's edge?)";
       reject(TargetRejection::kEdgeContinues, why.str(), c.area);
       continue;
     }
@@ -732,8 +736,12 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
     if (!aspect || !(aspect_error <= params.max_aspect_error)) {
       std::ostringstream why;
       why.precision(3);
-      why << "rectified width/height " << a << ", the sheet's is " << expected
-          << (focal_px > 0 ? "" : " (focal length unknown: best over 0.5-5 image sizes)");
+      if (!(a > 0))  // no focal length made its corners square: not a rectangle's image
+        why << "not a rectangle seen in perspective (no focal length of 0.5-5 image sizes "
+               "makes its corners square)";
+      else
+        why << "rectified width/height " << a << ", the sheet's is " << expected
+            << (focal_px > 0 ? "" : " (focal length unknown: best over 0.5-5 image sizes)");
       reject(TargetRejection::kAspect, why.str(), c.area);
       continue;
     }

@@ -466,7 +466,7 @@ TEST(TargetDetector, RejectionsSayWhy) {
   d = detectTarget(pole);
   EXPECT_FALSE(d.found);
   EXPECT_EQ(d.rejection, TargetRejection::kEdgeContinues) << d.reason;
-  EXPECT_NE(d.reason.find("past its corner"), std::string::npos) << d.reason;
+  EXPECT_NE(d.reason.find("past the corner at ("), std::string::npos) << d.reason;
   EXPECT_GT(d.rejected[static_cast<int>(TargetRejection::kEdgeContinues)], 0);
   // The same band on a dark card that leaves a margin round it (a sheet on a card on the
   // wall): its sides end at its corners: found.
