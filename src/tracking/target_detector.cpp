@@ -722,7 +722,6 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
     if (const auto [corner, fraction] = continuingSide(work, in_work, sigma); corner >= 0) {
       // Where, in the image: a user at the robot sees which corner lines up with what.
       std::ostringstream why;
-      why.precision(2);
       why << "an edge goes on past the corner at (" << std::fixed << std::setprecision(0)
           << (*refined)[corner].x << ", " << (*refined)[corner].y << ") px with "
           << std::setprecision(2) << fraction
@@ -736,9 +735,10 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
     if (!aspect || !(aspect_error <= params.max_aspect_error)) {
       std::ostringstream why;
       why.precision(3);
-      if (!(a > 0))  // no focal length made its corners square: not a rectangle's image
-        why << "not a rectangle seen in perspective (no focal length of 0.5-5 image sizes "
-               "makes its corners square)";
+      if (!(a > 0))  // not the image of a rectangle in front of the camera
+        why << (focal_px > 0 ? "not a rectangle in front of the camera"
+                             : "not a rectangle seen in perspective (no focal length of 0.5-5 "
+                               "image sizes makes its corners square)");
       else
         why << "rectified width/height " << a << ", the sheet's is " << expected
             << (focal_px > 0 ? "" : " (focal length unknown: best over 0.5-5 image sizes)");
