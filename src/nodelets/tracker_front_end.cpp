@@ -195,7 +195,12 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     if (target_wait_start_ns_ == 0 || stamp_ns < target_wait_start_ns_)
       target_wait_start_ns_ = stamp_ns;
     target_wait_last_ns_ = stamp_ns;
-    if (const auto target = target_startup_.process(image, tracker_, focal_px_, principal_px_)) {
+    // A camera_info for another image size is not this image's camera: its focal length
+    // and principal point would misjudge the sheet's shape (searched as a photo instead).
+    const bool info_fits = info_size_.empty() || info_size_ == image.size();
+    if (const auto target =
+            target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,
+                                    info_fits ? principal_px_ : cv::Point2d(-1, -1))) {
       std::ostringstream what;
       what << "start-up target (" << params_.target.target_type << ") confirmed in "
            << params_.target.confirm_frames << " consecutive images";

@@ -145,7 +145,8 @@ const ParamTable<TargetParams>& targetParamTable() {
       {"min_edge_snr", field(&P::min_edge_snr), 0, 1000, "",
        "sheet: each side's brightness step in noise standard deviations, at least"},
       {"max_aspect_error", field(&P::max_aspect_error), 0.001, 1, "",
-       "sheet: rectified width/height vs width_m/height_m, relative error allowed"},
+       "sheet: rectified width/height vs width_m/height_m, relative error allowed (paper, "
+       "calibration, corners)"},
       {"dictionary", field(&P::dictionary), 0, 0, "",
        "aruco: OpenCV predefined dictionary (DICT_4X4_50, DICT_6X6_250, ...)"},
       {"marker_id", field(&P::marker_id), 0, 999, "", "aruco: the marker's id"},

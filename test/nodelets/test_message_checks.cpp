@@ -13,6 +13,7 @@
 #include "../../src/nodelets/plane_messages.h"
 #include "../../src/nodelets/tracker_front_end.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
+#include "mono_plane_detection/tracking/target_detector.h"
 
 using namespace mono_plane_detection;
 
@@ -354,6 +355,32 @@ TEST(TrackerFrontEnd, TargetFoundAndConfirmedWithTheCameraInfo) {
       << square_front.targetReason();
   EXPECT_NE(square_front.targetRejections().find("aspect ratio "), std::string::npos)
       << square_front.targetRejections();
+}
+
+// A camera_info for another image size (1280x720, principal point 640, 360) is not the
+// images' camera: the sheet is searched as in a photo (focal length unknown), not with
+// those intrinsics, which make an oblique A4 sheet 2.19 wide after rectification.
+TEST(TrackerFrontEnd, TargetNotJudgedWithTheIntrinsicsOfAnotherImageSize) {
+  cv::Mat sheet(480, 640, CV_8UC1, cv::Scalar(30));
+  std::vector<cv::Point> corners;  // A4 0.8 m ahead, tilted 45 deg about x, 30 deg about y
+  const double tilt = 45 * CV_PI / 180, pan = 30 * CV_PI / 180;
+  for (const auto& c : targetCornersInMap(TargetParams())) {
+    const cv::Vec3d t(c.x, std::cos(tilt) * c.y, std::sin(tilt) * c.y);
+    const cv::Vec3d x(std::cos(pan) * t[0] + std::sin(pan) * t[2], t[1],
+                      0.8 - std::sin(pan) * t[0] + std::cos(pan) * t[2]);
+    corners.emplace_back(cvRound(320 + 500 * x[0] / x[2]), cvRound(240 + 500 * x[1] / x[2]));
+  }
+  cv::fillConvexPoly(sheet, corners, 230);
+  sensor_msgs::CameraInfo other = cameraInfo({0, 0, 0, 0, 0});
+  other.width = 1280;
+  other.height = 720;
+  other.K = {500, 0, 640, 0, 500, 360, 0, 0, 1};
+  other.P = {500, 0, 640, 0, 0, 500, 360, 0, 0, 0, 1, 0};
+  TrackerNodeParams params;
+  TrackerFrontEnd front(params);
+  EXPECT_EQ(front.setCameraInfo(other), "");
+  for (int k = 0; k < 5 && !front.targetFound(); ++k) front.process(image(sheet, 100, k * 100000000));
+  EXPECT_TRUE(front.targetFound()) << front.targetReason();
 }
 
 // Issue 18: `planes` lists tentative map planes too; `confirmed` (the map's own rule:

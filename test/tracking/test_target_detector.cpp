@@ -265,82 +265,100 @@ std::vector<std::string> filesIn(const std::string& dir, const std::string& ext)
   return out;
 }
 
+// The light-table setting (docs/start_up.md): max_surround_ratio raised for a sheet on
+// light wood (test4: 0.69-0.70).
+constexpr double kLightTableRatio = 0.75;
+
 }  // namespace
 
 // Issue 12: every sheet whose border with the darker surface is visible all round, at 640
 // and 1280 px wide, corners within 2 px (at 640 px) of the hand labels; the focal length
-// of these photos is unknown (0). test4.jpg lies on light wood (surround/sheet 0.69):
-// refused, with that reason.
+// of these photos is unknown (0). test4.jpg lies on light wood (surround/sheet 0.69): by
+// default refused, with that reason (light sheet-shaped rectangles on a mid-grey wall
+// are 0.48-0.87 and nothing else tells them apart); with the light-table setting found
+// too, within 2 px.
 TEST(TargetDetectorRealPhotos, FoundWithinTwoPixelsOfTheLabels) {
   const auto labels = readLabels();
   ASSERT_EQ(labels.size(), 5u);
-  int found = 0, expected = 0;
-  double worst_all = 0, sum_all = 0;
-  for (const Labelled& l : labels) {
-    for (const int width : {640, 1280}) {
-      double scale = 1;
-      const cv::Mat image = loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + l.file,
-                                        width, &scale);
-      ASSERT_FALSE(image.empty()) << l.file;
-      const TargetDetection d = detectTarget(image, l.params);
-      if (l.file == "test4.jpg") {
-        EXPECT_FALSE(d.found) << "light wood: refused by design";
-        EXPECT_EQ(d.rejection, TargetRejection::kBrightSurround) << d.reason;
-        continue;
+  for (const bool light_table : {false, true}) {
+    int found = 0, expected = 0;
+    double worst_all = 0, sum_all = 0;
+    for (const Labelled& l : labels) {
+      for (const int width : {640, 1280}) {
+        double scale = 1;
+        const cv::Mat image =
+            loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + l.file, width, &scale);
+        ASSERT_FALSE(image.empty()) << l.file;
+        TargetParams params = l.params;
+        if (light_table) params.max_surround_ratio = kLightTableRatio;
+        const TargetDetection d = detectTarget(image, params);
+        if (l.file == "test4.jpg" && !light_table) {
+          EXPECT_FALSE(d.found) << "light wood: refused by default";
+          EXPECT_EQ(d.rejection, TargetRejection::kBrightSurround) << d.reason;
+          continue;
+        }
+        ++expected;
+        ASSERT_TRUE(d.found) << l.file << " at " << width << ": " << d.reason;
+        ++found;
+        std::array<cv::Point2f, 4> in_file;
+        for (int i = 0; i < 4; ++i) in_file[i] = d.corners[i] / static_cast<float>(scale);
+        double mean = 0;
+        const double worst = worstCornerError(in_file, l.corners, &mean);
+        // In pixels of the image scaled to 640 px wide.
+        const double to640 = 640.0 / (image.cols / scale);
+        std::printf("%-16s %4d px: mean %.2f, worst %.2f px (at 640), surround/sheet %.2f\n",
+                    l.file.c_str(), width, mean * to640, worst * to640, d.surround_ratio);
+        EXPECT_LT(worst * to640, 2.0) << l.file << " at " << width;
+        worst_all = std::max(worst_all, worst * to640);
+        sum_all += mean * to640;
       }
-      ++expected;
-      ASSERT_TRUE(d.found) << l.file << " at " << width << ": " << d.reason;
-      ++found;
-      std::array<cv::Point2f, 4> in_file;
-      for (int i = 0; i < 4; ++i) in_file[i] = d.corners[i] / static_cast<float>(scale);
-      double mean = 0;
-      const double worst = worstCornerError(in_file, l.corners, &mean);
-      // In pixels of the image scaled to 640 px wide.
-      const double to640 = 640.0 / (image.cols / scale);
-      std::printf("%-16s %4d px: mean %.2f, worst %.2f px (at 640), surround/sheet %.2f\n",
-                  l.file.c_str(), width, mean * to640, worst * to640, d.surround_ratio);
-      EXPECT_LT(worst * to640, 2.0) << l.file << " at " << width;
-      worst_all = std::max(worst_all, worst * to640);
-      sum_all += mean * to640;
     }
+    std::printf("%s: found %d of %d, mean %.2f px, worst %.2f px (at 640 px width)\n",
+                light_table ? "light-table setting" : "default", found, expected,
+                sum_all / std::max(1, found), worst_all);
+    EXPECT_EQ(found, expected);
   }
-  std::printf("found %d of %d, mean %.2f px, worst %.2f px (at 640 px width)\n", found, expected,
-              sum_all / std::max(1, found), worst_all);
-  EXPECT_EQ(found, expected);
 }
 
 // Issue 12: never invented on real office frames (TUM RGB-D; the old detector took the
-// black-and-white striped pole of 1341847989.802890 for the sheet), with the camera's
-// focal length and without, at three sizes; nor on flat page scans (no surround).
+// black-and-white striped pole of 1341847989.802890 for the sheet, and stripes of it in
+// 1341847991.814748 at 1280 px and 1341847996.874766 at 640 px with the focal length
+// given), with the camera's focal length and without, at three sizes; nor on flat page
+// scans (no surround). With the default and the light-table setting.
 TEST(TargetDetectorRealPhotos, NoFalseTargets) {
   int checked = 0;
   std::vector<std::string> tum = filesIn(std::string(TEST_DATA_DIR) + "/tum_office", ".jpg");
   for (const auto& p : filesIn(std::string(TEST_DATA_DIR) + "/tum_office", ".png")) tum.push_back(p);
-  ASSERT_GE(tum.size(), 5u);
-  for (const std::string& path : tum) {
-    for (const int width : {320, 640, 1280}) {
-      double scale = 1;
-      const cv::Mat image = loadAtWidth(path, width, &scale);
-      ASSERT_FALSE(image.empty()) << path;
-      for (const double focal : {0.0, 535.4 * scale}) {
-        const TargetDetection d = detectTarget(image, TargetParams(), focal);
-        EXPECT_FALSE(d.found) << path << " at " << width << " px, focal " << focal;
-        EXPECT_FALSE(d.reason.empty());
-        ++checked;
+  ASSERT_GE(tum.size(), 8u);
+  for (const double ratio : {TargetParams().max_surround_ratio, kLightTableRatio}) {
+    TargetParams params;
+    params.max_surround_ratio = ratio;
+    for (const std::string& path : tum) {
+      for (const int width : {320, 640, 1280}) {
+        double scale = 1;
+        const cv::Mat image = loadAtWidth(path, width, &scale);
+        ASSERT_FALSE(image.empty()) << path;
+        for (const double focal : {0.0, 535.4 * scale}) {
+          const TargetDetection d = detectTarget(image, params, focal);
+          EXPECT_FALSE(d.found) << path << " at " << width << " px, focal " << focal
+                                << ", max_surround_ratio " << ratio;
+          EXPECT_FALSE(d.reason.empty());
+          ++checked;
+        }
       }
     }
-  }
-  for (const std::string name : {"result.jpg", "scanned_img.jpg"}) {
-    for (const int width : {640, 1280}) {
-      double scale = 1;
-      const cv::Mat image =
-          loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + name, width, &scale);
-      ASSERT_FALSE(image.empty()) << name;
-      for (const bool letter : {false, true}) {
-        TargetParams p;
-        if (letter) p.width_m = 0.2794, p.height_m = 0.2159;
-        EXPECT_FALSE(detectTarget(image, p).found) << name << " at " << width;
-        ++checked;
+    for (const std::string name : {"result.jpg", "scanned_img.jpg"}) {
+      for (const int width : {640, 1280}) {
+        double scale = 1;
+        const cv::Mat image =
+            loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + name, width, &scale);
+        ASSERT_FALSE(image.empty()) << name;
+        for (const bool letter : {false, true}) {
+          TargetParams p = params;
+          if (letter) p.width_m = 0.2794, p.height_m = 0.2159;
+          EXPECT_FALSE(detectTarget(image, p).found) << name << " at " << width;
+          ++checked;
+        }
       }
     }
   }
@@ -467,6 +485,25 @@ TEST(TargetDetector, RejectionsSayWhy) {
   EXPECT_EQ(d.rejection, TargetRejection::kBrightSurround) << d.reason;
   EXPECT_NE(d.reason.find("surround"), std::string::npos);
   EXPECT_GT(d.rejected[static_cast<int>(TargetRejection::kBrightSurround)], 0);
+  // A white band across a dark post on a darker wall (a striped pole): a bright
+  // quadrilateral of the sheet's shape with a dark surround all round, but its left and
+  // right sides go on past its corners as the post's edges: refused, and the reason
+  // says so.
+  cv::Mat pole(480, 640, CV_8UC1, cv::Scalar(90));
+  pole(cv::Rect(200, 0, 212, 480)).setTo(20);
+  pole(cv::Rect(200, 150, 212, 150)).setTo(240);
+  d = detectTarget(pole);
+  EXPECT_FALSE(d.found);
+  EXPECT_EQ(d.rejection, TargetRejection::kEdgeContinues) << d.reason;
+  EXPECT_NE(d.reason.find("past the corner at ("), std::string::npos) << d.reason;
+  EXPECT_GT(d.rejected[static_cast<int>(TargetRejection::kEdgeContinues)], 0);
+  // The same band on a dark card that leaves a margin round it (a sheet on a card on the
+  // wall): its sides end at its corners: found.
+  cv::Mat card(480, 640, CV_8UC1, cv::Scalar(90));
+  card(cv::Rect(150, 100, 312, 250)).setTo(20);
+  card(cv::Rect(200, 150, 212, 150)).setTo(240);
+  d = detectTarget(card);
+  EXPECT_TRUE(d.found) << d.reason;
   // A square: refused for its aspect ratio (seen head-on with the focal length given).
   cv::Mat square(480, 640, CV_8UC1, cv::Scalar(20));
   square(cv::Rect(220, 140, 200, 200)).setTo(230);
