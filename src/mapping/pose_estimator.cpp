@@ -21,17 +21,6 @@ cv::Matx34d cameraFromMap(const Pose& map_from_camera) {
   return projectionMatrix(c.R, c.t);
 }
 
-// The robust spread (1.4826 x the median absolute deviation) of the cameras' heights
-// above a floor, as a share of their median height.
-double relativeHeightSpread(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras) {
-  std::vector<double> heights, deviation;
-  for (const cv::Vec3d& c : cameras) heights.push_back(floor.up.dot(c) - floor.offset);
-  if (heights.empty()) return HUGE_VAL;
-  const double height = median(heights);
-  for (double h : heights) deviation.push_back(std::abs(h - height));
-  return height > 0 ? 1.4826 * median(deviation) / height : HUGE_VAL;
-}
-
 }  // namespace
 
 const char* toString(PoseSource source) {
@@ -241,33 +230,41 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   // Up to scale: the nominal up is only the camera's nominal pitch (a bobbing head's),
   // so the floor is looked for within max_floor_angle_deg of it, with tolerances as
   // shares of the cameras' height above each plane tried.
-  // Up to scale the map may have drifted in scale and orientation along the path since
-  // the start (the humanoid: 190 images, a turn among them): then the whole path is not
-  // parallel to the floor seen at its end, but the cameras the floor's landmarks were
-  // first seen from (their anchors, in the same drifted frame) are. Of the two, the set
-  // whose heights above the landmarks' own floor (a first fit without cameras) scatter
-  // less shares the floor's normal and gives the height (a wheeled path: the whole path;
-  // measured, docs/mapping.md: humanoid seed 0 distance 6.9 -> 3.4 %, seed 2 starts).
   std::vector<cv::Vec3d> cameras = check.cameras;
-  if (check.unscaled) {
+  FloorFit fit =
+      check.unscaled
+          ? fitFloorToLandmarks(points, sigma, cameras, check.start_up, p.max_floor_angle_deg,
+                                0.03, p.min_check_points, p.check_camera_sigma, true)
+          : fitFloorToLandmarks(points, sigma, cameras, check.start_up, p.max_check_angle_deg,
+                                0.03 * p.camera_height_m, p.min_check_points,
+                                p.check_camera_sigma * p.camera_height_m);
+  // Up to scale the map may have drifted in scale and orientation along the path since
+  // its start (the humanoid: 190 images, a turn among them): then the whole path is not
+  // parallel to the floor its end shows, and the fit with it finds no floor or one the
+  // camera's height over varies. The positions the floor's landmarks were first seen
+  // from (their anchors, as drifted as the landmarks; a first fit without cameras finds
+  // those landmarks) are then the cameras that share its normal and give its height.
+  // Measured (docs/mapping.md): humanoid seed 0 distance 6.9 -> 3.4 %, seed 2 starts.
+  if (check.unscaled &&
+      (!fit.ok || relativeHeightSpread(fit, cameras) > 3 * p.check_camera_sigma)) {
     const FloorFit alone =
         fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
                             p.max_floor_angle_deg, 0.03, p.min_check_points, 0, true);
     if (alone.ok) {
+      // Each position once: landmarks of one image share their anchor.
       std::vector<cv::Vec3d> seen_from;
-      for (int i : alone.inliers) seen_from.push_back(anchors[i]);
-      if (relativeHeightSpread(alone, seen_from) < relativeHeightSpread(alone, cameras))
+      for (int i : alone.inliers)
+        if (std::find(seen_from.begin(), seen_from.end(), anchors[i]) == seen_from.end())
+          seen_from.push_back(anchors[i]);
+      FloorFit again =
+          fitFloorToLandmarks(points, sigma, seen_from, check.start_up, p.max_floor_angle_deg,
+                              0.03, p.min_check_points, p.check_camera_sigma, true);
+      if (again.ok) {
+        fit = std::move(again);
         cameras = std::move(seen_from);
+      }
     }
   }
-  const FloorFit fit =
-      check.unscaled
-          ? fitFloorToLandmarks(points, sigma, cameras, check.start_up,
-                                p.max_floor_angle_deg, 0.03, p.min_check_points,
-                                p.check_camera_sigma, true)
-          : fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
-                                p.max_check_angle_deg, 0.03 * p.camera_height_m,
-                                p.min_check_points, p.check_camera_sigma * p.camera_height_m);
   if (check.unscaled) {
     // No start to undo: it waits for the floor landmarks (the camera's loss undoes it).
     if (!fit.ok || normalAngleDeg(fit.up, check.start_up) > p.max_floor_angle_deg) {
