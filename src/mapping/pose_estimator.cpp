@@ -233,8 +233,8 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   std::vector<cv::Vec3d> cameras = check.cameras;
   FloorFit fit =
       check.unscaled
-          ? fitFloorToLandmarks(points, sigma, cameras, check.start_up, p.max_floor_angle_deg,
-                                0.03, p.min_check_points, p.check_camera_sigma, true)
+          ? fitFloorToLandmarks(points, sigma, cameras, check.start_up, p.max_floor_angle_deg, 0.03,
+                                p.min_check_points, p.check_camera_sigma, true)
           : fitFloorToLandmarks(points, sigma, cameras, check.start_up, p.max_check_angle_deg,
                                 0.03 * p.camera_height_m, p.min_check_points,
                                 p.check_camera_sigma * p.camera_height_m);
@@ -248,8 +248,8 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   if (check.unscaled &&
       (!fit.ok || relativeHeightSpread(fit, cameras) > 3 * p.check_camera_sigma)) {
     const FloorFit alone =
-        fitFloorToLandmarks(points, sigma, check.cameras, check.start_up,
-                            p.max_floor_angle_deg, 0.03, p.min_check_points, 0, true);
+        fitFloorToLandmarks(points, sigma, check.cameras, check.start_up, p.max_floor_angle_deg,
+                            0.03, p.min_check_points, 0, true);
     if (alone.ok) {
       // Each position once: landmarks of one image share their anchor.
       std::vector<cv::Vec3d> seen_from;
@@ -257,8 +257,8 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
         if (std::find(seen_from.begin(), seen_from.end(), anchors[i]) == seen_from.end())
           seen_from.push_back(anchors[i]);
       FloorFit again =
-          fitFloorToLandmarks(points, sigma, seen_from, check.start_up, p.max_floor_angle_deg,
-                              0.03, p.min_check_points, p.check_camera_sigma, true);
+          fitFloorToLandmarks(points, sigma, seen_from, check.start_up, p.max_floor_angle_deg, 0.03,
+                              p.min_check_points, p.check_camera_sigma, true);
       if (again.ok) {
         fit = std::move(again);
         cameras = std::move(seen_from);
@@ -295,8 +295,7 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
       floor_reason_ = "floor found, checking it: " + fit.reason;
     return false;
   }
-  const Similarity s =
-      floorCorrection(fit, cameras, check.cameras.front(), p.camera_height_m);
+  const Similarity s = floorCorrection(fit, cameras, check.cameras.front(), p.camera_height_m);
   if (!check.unscaled && (normalAngleDeg(fit.up, check.start_up) > p.max_check_angle_deg ||
                           std::abs(s.scale - 1) > p.max_check_scale)) {
     undoFloorStart("the start's floor disagreed with the map's floor: started again");

@@ -294,7 +294,8 @@ TEST(CameraHeightScale, RelativeHeightSpread) {
   floor.ok = true;
   floor.up = cv::Vec3d(0, 1, 0);
   floor.offset = -0.5;  // heights are y + 0.5
-  const std::vector<cv::Vec3d> cameras{{0, 0.5, 0}, {1, 0.52, 0}, {2, 0.48, 0}, {3, 0.54, 0}, {4, 0.46, 0}};
+  const std::vector<cv::Vec3d> cameras{
+      {0, 0.5, 0}, {1, 0.52, 0}, {2, 0.48, 0}, {3, 0.54, 0}, {4, 0.46, 0}};
   // Heights 1.0, 1.02, 0.98, 1.04, 0.96: median deviation 0.02 of the median height 1.
   EXPECT_NEAR(relativeHeightSpread(floor, cameras), 1.4826 * 0.02, 1e-9);
   EXPECT_TRUE(std::isinf(relativeHeightSpread(floor, {})));
