@@ -172,8 +172,8 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
       // An up-to-scale start waits for its floor as long as it takes: an image the
       // landmarks do not place (a jerk of the head) loses nothing while they are still in
       // view, as after the check (measured: humanoid noise seed 2 lost its first start
-      // at image 65 this way, started again at image 85 after the front wall's best
-      // views, and missed that wall).
+      // near image 65 this way, started again near image 85, after the front wall's
+      // best views, and missed that wall).
       floor_reason_ = "started up to scale, this image not placed: waiting for the map's floor";
       return {};
     }
