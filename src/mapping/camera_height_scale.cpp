@@ -476,6 +476,16 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
   return out;
 }
 
+double relativeHeightSpread(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras) {
+  std::vector<double> heights, deviation;
+  for (const cv::Vec3d& c : cameras) heights.push_back(floor.up.dot(c) - floor.offset);
+  if (heights.empty()) return HUGE_VAL;
+  const double height = median(heights);
+  if (!(height > 0)) return HUGE_VAL;
+  for (double h : heights) deviation.push_back(std::abs(h - height));
+  return 1.4826 * median(deviation) / height;
+}
+
 Similarity floorCorrection(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras,
                            const cv::Vec3d& origin_camera, double camera_height_m) {
   Similarity s;

@@ -141,9 +141,11 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   if (pose_ && !pose_->scaleKnown()) {
     // At most 1000 images (33 s at 30 images/s): an up-to-scale start waits for the
     // floor without a time limit, memory must not.
+    // An image the start's landmarks do not place adds nothing; an undone start (not
+    // initialised any more) drops what waited.
     if (pose_->checkingPose())
       pending_.push_back({frame.stamp, *pose_->checkingPose(), result.planes});
-    else
+    else if (!pose_->initialised())
       pending_.clear();
     if (pending_.size() > 1000) pending_.pop_front();
   }

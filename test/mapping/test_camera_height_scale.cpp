@@ -2,6 +2,7 @@
 // camera's known height, against the true motion.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <unordered_map>
 
@@ -286,4 +287,17 @@ TEST(CameraHeightScale, TheCamerasPathFixesTheStripsTilt) {
               alone_sum / 10, with_sum / 10);
   EXPECT_LT(with_sum, 0.5 * alone_sum);
   EXPECT_LT(with_sum / 10, 1.0);
+}
+
+TEST(CameraHeightScale, RelativeHeightSpread) {
+  FloorFit floor;
+  floor.ok = true;
+  floor.up = cv::Vec3d(0, 1, 0);
+  floor.offset = -0.5;  // heights are y + 0.5
+  const std::vector<cv::Vec3d> cameras{
+      {0, 0.5, 0}, {1, 0.52, 0}, {2, 0.48, 0}, {3, 0.54, 0}, {4, 0.46, 0}};
+  // Heights 1.0, 1.02, 0.98, 1.04, 0.96: median deviation 0.02 of the median height 1.
+  EXPECT_NEAR(relativeHeightSpread(floor, cameras), 1.4826 * 0.02, 1e-9);
+  EXPECT_TRUE(std::isinf(relativeHeightSpread(floor, {})));
+  EXPECT_TRUE(std::isinf(relativeHeightSpread(floor, {{0, -2, 0}})));  // below the floor
 }

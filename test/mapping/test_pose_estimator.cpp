@@ -2,6 +2,8 @@
 // against the true trajectory.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
 #include "support/synthetic_tracks.h"
@@ -324,4 +326,32 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
     EXPECT_LT(tilt_deg, 3.0) << path;
     EXPECT_NEAR(est_cam.front()[1], height, 0.05 * height) << path;
   }
+}
+
+TEST(PoseEstimator, AnImageNotPlacedKeepsAnUnscaledStart) {
+  // The humanoid's head starts up to scale (no floor in the image); one image the
+  // landmarks cannot place (its tracks scrambled: PnP fails) must not undo that start
+  // while its landmarks are in view; an image of only new tracks (none in view) does.
+  const SyntheticTracks world("humanoid", 100);
+  PoseEstimator estimator(world.camera.K(), world.camera.distortion(),
+                          source("camera_height", 1.2));
+  int k = 0, checking = 0;
+  for (; k < 240 && checking < 5; ++k) {
+    estimator.update(withoutTarget(world.frame(k / 30.0)));
+    checking = estimator.checkingPose() ? checking + 1 : 0;
+  }
+  ASSERT_EQ(checking, 5) << estimator.waitingFor();
+  ASSERT_FALSE(estimator.scaleKnown());
+  TrackFrame scrambled = withoutTarget(world.frame(k / 30.0));
+  std::reverse(scrambled.pixels.begin(), scrambled.pixels.end());
+  EXPECT_FALSE(estimator.update(scrambled));
+  EXPECT_FALSE(estimator.checkingPose());
+  EXPECT_TRUE(estimator.initialised()) << estimator.waitingFor();
+  estimator.update(withoutTarget(world.frame(++k / 30.0)));
+  EXPECT_TRUE(estimator.checkingPose() || estimator.scaleKnown()) << estimator.waitingFor();
+  if (estimator.scaleKnown()) return;  // checked meanwhile: nothing left to undo
+  TrackFrame fresh = withoutTarget(world.frame(++k / 30.0));
+  for (std::uint64_t& id : fresh.ids) id += 1000000;  // tracks never seen
+  EXPECT_FALSE(estimator.update(fresh));
+  EXPECT_FALSE(estimator.initialised()) << "a start whose landmarks left the view is undone";
 }

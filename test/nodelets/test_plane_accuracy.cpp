@@ -12,7 +12,8 @@
 // plane's distance from the first camera, camera < 5 % of the path (held on every
 // image-noise seed that starts); its map up < 4 deg. The humanoid's camera_height map
 // (an up-to-scale start whose floor is mapped only after the turn) misses the issue's
-// bounds (left wall 3.25 deg, front wall 6.9 %): held to 4 deg and 8 % (docs/mapping.md).
+// normal bound (left wall 3.45 deg): held to 4 deg, its distances to the 5 %
+// (docs/mapping.md).
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -206,10 +207,13 @@ TEST(PlaneAccuracy, RenderedSequence) {
     // Measured after the floor check (wheeled): camera 0.4 %, worst normal 1.4 deg (front
     // wall), worst distance 2.8 % (front wall); on the four other image-noise seeds
     // within 0.9 %, 2.1 deg and 3.5 % (docs/mapping.md); with the tracker's corner spread
-    // (spread_grid_columns) 1.9 deg (left wall), 0.8 %. Humanoid: camera 0.3 %, normals 1.9
-    // (front wall), 3.3 (left wall), 1.7 deg (floor), distances 6.9 % (front wall), 0.3 %,
-    // 0.5 %: the 3 deg and 5 % are NOT met on the humanoid (its map rests on few
-    // floor landmarks, mapped late); held to 4 deg and 8 % so that a worse start fails.
+    // (spread_grid_columns) 1.9 deg (left wall), 0.8 %. Humanoid (the check's camera set
+    // from the floor landmarks' anchors when the drifted path finds no floor): camera
+    // 0.1 %, normals 2.0 (front wall), 3.45 (left wall), 2.05 deg (floor), distances 3.4 %
+    // (front wall), 2.6 %, 2.4 %; image-noise seeds 1-4 within 3.23 deg and 3.1 %
+    // (run_pipeline). The 3 deg is NOT met on the humanoid (the
+    // up-to-scale map drifts between the left wall, mapped before the turn, and the
+    // floor after it): held to 4 deg so that a worse start fails; distances to 5 %.
     EXPECT_LT(worst, 0.05 * truth.travelled_m);
     EXPECT_LT(e.worst_normal_error_deg, humanoid_height ? 4.0 : 3.0);
     for (size_t i = 0; i < mapped.size(); ++i)
@@ -218,7 +222,7 @@ TEST(PlaneAccuracy, RenderedSequence) {
           const double relative = e.matches[i].distance_error_m / std::abs(t.distance);
           std::printf("  plane %d: distance error %.1f %% of %.2f m\n", mapped[i].id,
                       100 * relative, std::abs(t.distance));
-          EXPECT_LT(relative, humanoid_height ? 0.08 : 0.05) << t.name;
+          EXPECT_LT(relative, 0.05) << t.name;
         }
   }
 }

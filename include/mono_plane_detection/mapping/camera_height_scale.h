@@ -105,6 +105,10 @@ FloorFit fitFloorToLandmarks(const std::vector<cv::Vec3d>& points,
                              double max_angle_deg, double tolerance_m, int min_points,
                              double camera_sigma_m = 0, bool relative = false);
 
+// The robust spread (1.4826 x the median absolute deviation) of the cameras' heights
+// above a floor, as a share of their median height; infinite without a camera above it.
+double relativeHeightSpread(const FloorFit& floor, const std::vector<cv::Vec3d>& cameras);
+
 // x' = scale * R * x + t: a similarity of the map.
 struct Similarity {
   double scale = 1;

@@ -141,6 +141,8 @@ class PoseEstimator {
   // start when the floor disagrees.
   bool checkFloor(PoseEstimate& estimate, const std::optional<Pose>& odom_from_camera);
   void undoFloorStart(const std::string& why);
+  // Tracks of this image with a landmark position (landmarkPosition).
+  int landmarksInView(const TrackFrame& frame) const;
 
   struct FirstView {  // the image the two-view start measures motion from
     std::vector<std::uint64_t> ids;
