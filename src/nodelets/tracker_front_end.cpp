@@ -70,8 +70,9 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   const bool fisheye = usable && !lens.fisheye_D.empty();
   focal_px_ = usable ? lens.K(0, 0) : 0;
   principal_px_ = usable ? cv::Point2d(lens.K(0, 2), lens.K(1, 2)) : cv::Point2d(-1, -1);
-  target_startup_.setLens(usable ? lens.K : cv::Matx33d::eye(),
-                          usable ? (fisheye ? lens.fisheye_D : lens.D) : cv::Mat(), fisheye);
+  lens_K_ = usable ? lens.K : cv::Matx33d::eye();
+  lens_D_ = usable ? (fisheye ? lens.fisheye_D : lens.D) : cv::Mat();
+  lens_fisheye_ = fisheye;
   return error;
 }
 
@@ -189,15 +190,19 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   tracker_.process(image);
   // Paper II-A: until the start-up target is seen, look for it; its corners become
   // tracked points flagged as target corners.
+  // A camera_info for another image size is not this image's camera: its lens would bend
+  // the sheet's sides and its focal length misjudge its shape (searched as a photo instead).
+  const bool info_fits = info_size_.empty() || info_size_ == image.size();
+  if (params_.detect_target) {
+    target_startup_.setLens(info_fits ? lens_K_ : cv::Matx33d::eye(),
+                            info_fits ? lens_D_ : cv::Mat(), info_fits && lens_fisheye_);
+  }
   if (params_.detect_target && !target_startup_.found()) {
     // The wait counts from the first image searched (after a reset too: the reset
     // already said why), in image stamps.
     if (target_wait_start_ns_ == 0 || stamp_ns < target_wait_start_ns_)
       target_wait_start_ns_ = stamp_ns;
     target_wait_last_ns_ = stamp_ns;
-    // A camera_info for another image size is not this image's camera: its focal length
-    // and principal point would misjudge the sheet's shape (searched as a photo instead).
-    const bool info_fits = info_size_.empty() || info_size_ == image.size();
     if (const auto target =
             target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,
                                     info_fits ? principal_px_ : cv::Point2d(-1, -1))) {
@@ -217,7 +222,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     }
   } else if (params_.detect_target) {
     // Confirmed: found again around its tracked corners, which then do not drift.
-    target_startup_.process(image, tracker_, focal_px_, principal_px_);
+    target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,
+                            info_fits ? principal_px_ : cv::Point2d(-1, -1));
   }
   const TrackerFrameStats& stats = tracker_.lastStats();
   counts_.searches += stats.searched ? 1 : 0;

@@ -83,6 +83,11 @@ class TrackerFrontEnd {
   bool rectified_ = false;
   double focal_px_ = 0;            // from camera_info (K, or P when rectified), 0 when unknown
   cv::Point2d principal_px_{-1, -1};  // the same, negative when unknown
+  // The lens the target is undistorted with (identity and none when unknown); given to
+  // the target start-up only for images of camera_info's size.
+  cv::Matx33d lens_K_ = cv::Matx33d::eye();
+  cv::Mat lens_D_;
+  bool lens_fisheye_ = false;
   uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
   uint64_t target_wait_last_ns_ = 0;
   GapCounter gaps_;

@@ -22,13 +22,15 @@ void TargetStartup::reset() {
 }
 
 void TargetStartup::setLens(const cv::Matx33d& K, const cv::Mat& D, bool fisheye) {
-  const cv::Mat d = D.empty() || cv::countNonZero(D) == 0 ? cv::Mat() : D.clone();
-  // camera_info comes with every image: the maps are made again only when the lens changes.
-  const bool same = K == K_ && fisheye == fisheye_ && d.size() == D_.size() &&
-                    (d.empty() || cv::norm(d, D_, cv::NORM_INF) == 0);
+  const bool no_d = D.empty() || cv::countNonZero(D) == 0;
+  // Set with every image: the maps are made again (and D copied) only when the lens changes.
+  const bool same = K == K_ && fisheye == fisheye_ &&
+                    (no_d ? D_.empty()
+                          : D.size() == D_.size() && D.type() == D_.type() &&
+                                cv::norm(D, D_, cv::NORM_INF) == 0);
   if (same) return;
   K_ = K;
-  D_ = d;
+  D_ = no_d ? cv::Mat() : D.clone();
   fisheye_ = fisheye;
   map_size_ = cv::Size();
 }

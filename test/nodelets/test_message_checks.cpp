@@ -371,7 +371,7 @@ TEST(TrackerFrontEnd, TargetNotJudgedWithTheIntrinsicsOfAnotherImageSize) {
     corners.emplace_back(cvRound(320 + 500 * x[0] / x[2]), cvRound(240 + 500 * x[1] / x[2]));
   }
   cv::fillConvexPoly(sheet, corners, 230);
-  sensor_msgs::CameraInfo other = cameraInfo({0, 0, 0, 0, 0});
+  sensor_msgs::CameraInfo other = cameraInfo({-0.3, 0.08, 0, 0, 0});  // a wide lens
   other.width = 1280;
   other.height = 720;
   other.K = {500, 0, 640, 0, 500, 360, 0, 0, 1};
