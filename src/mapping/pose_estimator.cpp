@@ -168,18 +168,24 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   else
     estimate = visualPose(frame, normalized);
   if (!estimate) {
-    if (floor_check_ && floor_check_->unscaled && landmarksInView(frame) >= params_.min_pnp_points) {
-      // An up-to-scale start waits for its floor as long as it takes: an image the
-      // landmarks do not place (a jerk of the head) loses nothing while they are still in
-      // view, as after the check (measured: humanoid noise seed 2 lost its first start
-      // near image 65 this way, started again near image 85, after the front wall's
-      // best views, and missed that wall).
+    // An up-to-scale start waits for its floor as long as it takes: an image the
+    // landmarks do not place (a jerk of the head) loses nothing while they are still in
+    // view, as after the check (measured: humanoid noise seed 2 lost its first start
+    // near image 65 this way, started again near image 85, after the front wall's best
+    // views, and missed that wall). But a second of images none of which is placed (each
+    // refused, e.g. as a jump from the last pose) is a loss: the start is made again.
+    constexpr double kMaxUnplacedS = 1.0;
+    if (floor_check_ && floor_check_->unscaled &&
+        landmarksInView(frame) >= params_.min_pnp_points &&
+        (floor_check_->last_placed_s < 0 ||
+         frame.stamp - floor_check_->last_placed_s <= kMaxUnplacedS)) {
       floor_reason_ = "started up to scale, this image not placed: waiting for the map's floor";
       return {};
     }
     if (floor_check_) undoFloorStart("lost while checking the floor");
     return {};
   }
+  if (floor_check_) floor_check_->last_placed_s = frame.stamp;
   last_pose_ = estimate->map_from_camera;
   for (size_t i = 0; i < frame.ids.size(); ++i) {
     const auto it = landmarks_.find(frame.ids[i]);
@@ -256,9 +262,10 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   // Up to scale the map may have drifted in scale and orientation along the path since
   // its start (the humanoid: 190 images, a turn among them): then the whole path is not
   // parallel to the floor its end shows, and the fit with it finds no floor or one the
-  // camera's height over varies. The positions the floor's landmarks were first seen
-  // from (their anchors, as drifted as the landmarks; a first fit without cameras finds
-  // those landmarks) are then the cameras that share its normal and give its height.
+  // camera's height over varies. The positions the floor's landmarks were triangulated
+  // from (their anchors, as drifted as the landmarks; a first fit with no weight on the
+  // cameras finds those landmarks) are then the cameras that share its normal and give
+  // its height: at least 5 of them, else the height test below could not fail.
   // Measured (docs/mapping.md): humanoid seed 0 distance 6.9 -> 3.4 %, seed 2 starts.
   if (check.unscaled &&
       (!fit.ok || relativeHeightSpread(fit, cameras) > 3 * p.check_camera_sigma)) {
@@ -271,9 +278,11 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
       for (int i : alone.inliers)
         if (std::find(seen_from.begin(), seen_from.end(), anchors[i]) == seen_from.end())
           seen_from.push_back(anchors[i]);
-      FloorFit again =
-          fitFloorToLandmarks(points, sigma, seen_from, check.start_up, p.max_floor_angle_deg, 0.03,
-                              p.min_check_points, p.check_camera_sigma, true);
+      constexpr size_t kMinPositions = 5;
+      FloorFit again;
+      if (seen_from.size() >= kMinPositions)
+        again = fitFloorToLandmarks(points, sigma, seen_from, check.start_up, p.max_floor_angle_deg,
+                                    0.03, p.min_check_points, p.check_camera_sigma, true);
       if (again.ok) {
         fit = std::move(again);
         cameras = std::move(seen_from);

@@ -355,3 +355,28 @@ TEST(PoseEstimator, AnImageNotPlacedKeepsAnUnscaledStart) {
   EXPECT_FALSE(estimator.update(fresh));
   EXPECT_FALSE(estimator.initialised()) << "a start whose landmarks left the view is undone";
 }
+
+TEST(PoseEstimator, ASecondOfImagesNotPlacedUndoesAnUnscaledStart) {
+  // Landmarks in view but no image placed (each one's tracks scrambled, as after a jump
+  // every pose would be refused): the start is not kept for ever, it is made again.
+  const SyntheticTracks world("humanoid", 100);
+  PoseEstimator estimator(world.camera.K(), world.camera.distortion(),
+                          source("camera_height", 1.2));
+  int k = 0, checking = 0;
+  for (; k < 240 && checking < 5; ++k) {
+    estimator.update(withoutTarget(world.frame(k / 30.0)));
+    checking = estimator.checkingPose() ? checking + 1 : 0;
+  }
+  ASSERT_EQ(checking, 5) << estimator.waitingFor();
+  ASSERT_FALSE(estimator.scaleKnown());
+  int kept = 0;
+  for (int i = 0; i < 45 && estimator.initialised(); ++i, ++k) {
+    TrackFrame scrambled = withoutTarget(world.frame(k / 30.0));
+    std::reverse(scrambled.pixels.begin(), scrambled.pixels.end());
+    EXPECT_FALSE(estimator.update(scrambled));
+    kept += estimator.initialised();
+  }
+  EXPECT_FALSE(estimator.initialised()) << "still started after 45 images none placed";
+  EXPECT_GE(kept, 25);  // 1 s at 30 Hz: kept meanwhile
+  EXPECT_LE(kept, 31);
+}

@@ -190,6 +190,7 @@ class PoseEstimator {
     // floor_max_angle_deg of the nominal up, its scale is not bounded, and the start is
     // not undone for want of a floor.
     bool unscaled = false;
+    double last_placed_s = -1;  // stamp of the newest image placed since the start
   };
   std::optional<FloorCheck> floor_check_;
   std::optional<PoseEstimate> checking_pose_;
