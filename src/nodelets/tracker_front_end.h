@@ -61,6 +61,7 @@ class TrackerFrontEnd {
   const TrackerCounts& counts() const { return counts_; }
   bool hasCameraInfo() const { return !info_size_.empty(); }
   bool targetFound() const { return target_startup_.found(); }
+  const TargetStartup& targetStartup() const { return target_startup_; }
   // Why the last image gave no target (empty once found or before any image).
   std::string targetReason() const;
   // The last image's candidates by rejection ("weak edge 12, bright surround 2"): which

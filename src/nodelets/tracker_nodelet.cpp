@@ -6,9 +6,11 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <std_srvs/Empty.h>
 
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "callback_guard.h"
@@ -187,6 +189,16 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
+    if (front_.targetFound() && front_.params().target.redetect_tracked) {
+      // Never moved while the sheet is tracked: its re-detection fails (e.g. the region
+      // too small or its surround changed); the start then uses the tracks as they drift.
+      const TargetStartup& t = front_.targetStartup();
+      std::ostringstream moved;
+      moved << t.reanchoredImages() << " of " << t.followedImages()
+            << " images with its four corners tracked (last move "
+            << std::fixed << std::setprecision(2) << t.lastReanchorShiftPx() << " px)";
+      status.add("target: corners re-detected", moved.str());
+    }
     if (front_.params().detect_target && !front_.targetFound()) {
       // What to fix at the robot: light, background, distance (docs/start_up.md).
       status.add("target type", front_.params().target.target_type);

@@ -157,8 +157,8 @@ const ParamTable<TargetParams>& targetParamTable() {
       {"confirm_tolerance_px", field(&P::confirm_tolerance_px), 0.01, 100, "px",
        "detected vs Lucas-Kanade-tracked corner, largest distance, to count as consistent"},
       {"redetect_tracked", field(&P::redetect_tracked), 0, 1, "",
-       "after confirmation, find the target again in each image and move its tracked corners "
-       "onto the detected ones (same ids) when they agree within confirm_tolerance_px"},
+       "tracker: after confirmation, find the target again in each image and move its tracked "
+       "corners onto the detected ones (same ids) when they agree within confirm_tolerance_px"},
   };
   return table;
 }
@@ -382,7 +382,8 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
     t.push_back({"lazy", field(&P::lazy), 0, 1, "",
                  "subscribe to the image only while tracks or debug_image have listeners"});
     t.push_back({"detect_target", field(&P::detect_target), 0, 1, "",
-                 "look for the start-up target (paper II-A) until found"});
+                 "look for the start-up target (paper II-A) until found, then around its "
+                 "tracked corners (target/redetect_tracked); false: neither"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
                  "a longer pause between images (and over 3 of their periods) is a tracking loss "
                  "(start over)"});

@@ -581,7 +581,7 @@ std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double f
 namespace {
 
 // The aspect check. With the focal length known (the nodelet: camera_info), the
-// rectified width/height must be the sheet's. Unknown (a photo given to detect_target):
+// rectified width/height must be the sheet's (at a focal length within 5 % of it). Unknown (a photo given to detect_target):
 // some focal length from 0.5 to 5 image sizes (a cropped photo has a long one) must make
 // the quadrilateral a rectangle (sides within 9 deg of square) of the sheet's shape.
 // Returns the relative aspect error of the best focal length, and its aspect.
@@ -598,7 +598,10 @@ std::pair<double, double> aspectError(const Quad& quad, cv::Size image, double f
     if (error < best.first) best = {error, a};
   };
   if (focal_px > 0) {
-    consider(focal_px, false);
+    // The aspect follows f about 1:1 in an oblique view, and a camera_info's focal length
+    // may be a few percent off (a driver's nominal K, an old calibration): the best one
+    // within 5 % of it, in 1 % steps, so a 2 % tolerance does not refuse such a camera.
+    for (int step = -5; step <= 5; ++step) consider(focal_px * (1 + 0.01 * step), false);
     return best;
   }
   const double size = std::max(image.width, image.height);

@@ -18,6 +18,7 @@ void TargetStartup::reset() {
   corner_ids_.clear();
   reanchored_ = false;
   reanchored_images_ = 0;
+  followed_images_ = 0;
   last_shift_px_ = 0;
 }
 
@@ -83,6 +84,7 @@ void TargetStartup::followTarget(const cv::Mat& gray, FeatureTracker& tracker) {
         ++alive;
       }
   if (alive < 4) return;  // a corner lost: the target is leaving the view or hidden
+  ++followed_images_;
   // The region: the tracked quadrilateral (undistorted, where the sides are straight) with
   // a margin for the surround the detector measures its sides against (an eighth of the
   // size: a quarter found the same corners at 1.25x the time, benchmark_suite).

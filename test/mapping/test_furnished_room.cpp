@@ -114,11 +114,12 @@ bool found(const RoomRun& run, const std::string& name) {
 
 }  // namespace
 
-// Figures on this commit (normal deg / distance m), wheeled: front wall 0.87 / 0.009, floor
-// 0.81 / 0.008, shelf front 1.94 / 0.005, left wall 1.26 / 0.098, camera 1.4 % of the path
-// (2.0 % before the start averaged its orientation over the images); humanoid: front wall
-// 0.59 / 0.001, shelf front 0.64 / 0.000, left wall 0.69 / 0.000, floor 0.81 / 0.022,
-// camera 0.5 %. Missed, and not mappable here (docs/mapping.md): the
+// Figures on this commit (normal deg / distance m), wheeled: front wall 0.78 / 0.006, floor
+// 0.74 / 0.003, shelf front 1.51 / 0.010, left wall 1.96 / 0.096, camera 1.1 % of the path
+// (2.0 % before the start averaged its orientation over the images, 1.4 % before the
+// sheet was re-detected around its tracks); humanoid: front wall 0.50 / 0.000, shelf front
+// 0.39 / 0.004, left wall 0.28 / 0.022, floor 0.23 / 0.022, camera 0.6 %. Missed, and not
+// mappable here (docs/mapping.md): the
 // sideboard front (wheeled: in view only before the metric start) and the back wall
 // (humanoid: plain paint, no corner on it).
 TEST(FurnishedRoom, WheeledPath) {
@@ -132,10 +133,11 @@ TEST(FurnishedRoom, WheeledPath) {
   EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);  // the bound
   EXPECT_LT(run.eval.worst_distance_error_m, 0.10);
   EXPECT_GE(run.posed, 250);
-  // Worst near the metric start (the target seen face-on from 2 m tilts the map: 1.9 deg
-  // with the corners averaged, 2.0 % of the path; less with the orientations averaged,
-  // docs/mapping.md "The wheeled start's tilt"), not in the turn.
-  EXPECT_LT(run.worst_camera_m, 0.018 * run.travelled_m);
+  // The target seen face-on from 2 m tilts the map (1.9 deg with the corners averaged,
+  // 2.0 % of the path; 1.4 % with the orientations averaged, 1.1 % with the corners
+  // re-detected: docs/mapping.md "The wheeled start's tilt"); the worst is now at the end
+  // of the path. Runs move by 0.3 % with small corner changes.
+  EXPECT_LT(run.worst_camera_m, 0.015 * run.travelled_m);
 }
 
 TEST(FurnishedRoom, HumanoidPath) {
@@ -149,7 +151,9 @@ TEST(FurnishedRoom, HumanoidPath) {
   // the start: 0.003 m with the start's corners averaged, 0.022 m with its orientations.
   EXPECT_LT(run.eval.worst_distance_error_m, 0.03);
   EXPECT_GE(run.posed, 250);
-  EXPECT_LT(run.worst_camera_m, 0.007 * run.travelled_m);
+  // 0.5 % before the sheet was re-detected, 0.3-0.6 % since (with the search region's
+  // margin): the 1 % with room to move.
+  EXPECT_LT(run.worst_camera_m, 0.008 * run.travelled_m);
 }
 
 // The same wheeled path with the map from the first image (odometry): the planes without

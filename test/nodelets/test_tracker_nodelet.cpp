@@ -336,6 +336,12 @@ TEST_F(TrackerNodeletTest, StartUpTargetCornersAreFlaggedAndTracked) {
   std::printf("target corners over 18 images: worst %.3f px from the truth\n", worst);
   // Measured: 0.105 px re-anchored; 0.281 px with target/redetect_tracked false (drift).
   EXPECT_LT(worst, 0.2);
+  // A user sees that it works: "N of M images with its four corners tracked ...".
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const std::string moved = diagnostics.value("target: corners re-detected");
+  ASSERT_FALSE(moved.empty());
+  EXPECT_GE(std::stoi(moved), 15) << moved;  // of the 17 images after confirmation
 }
 
 // Issue 12, bad input: images without a target for longer than target_timeout_s (1 s in

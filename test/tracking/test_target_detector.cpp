@@ -110,6 +110,20 @@ TEST(TargetDetector, OnTheFloorInTheSameOrder) {
   EXPECT_LT(d.corners[0].x, d.corners[1].x);
 }
 
+// The sheet on the floor, seen obliquely (its aspect follows the focal length about 1:1):
+// a camera_info a few percent off still finds it, a wrong camera does not.
+TEST(TargetDetector, FocalLengthAFewPercentOffStillFindsTheSheet) {
+  const View v = render("floor", "wheeled", 0.0);
+  const cv::Matx33d K = v.camera.K();
+  const cv::Point2d principal(K(0, 2), K(1, 2));
+  for (const double off : {0.97, 1.0, 1.04}) {
+    const TargetDetection d = detectTarget(v.image, TargetParams(), K(0, 0) * off, principal);
+    EXPECT_TRUE(d.found) << "focal length x" << off << ": " << d.reason;
+  }
+  const TargetDetection wrong = detectTarget(v.image, TargetParams(), K(0, 0) * 1.3, principal);
+  EXPECT_FALSE(wrong.found) << "focal length 30 % off";
+}
+
 TEST(TargetDetector, NothingWhenTheTargetIsOutOfView) {
   int checked = 0;
   for (double t = 5.0; t <= 10.0; t += 0.5) {

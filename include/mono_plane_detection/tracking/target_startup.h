@@ -47,9 +47,11 @@ class TargetStartup {
   const TargetDetection& lastDetection() const { return last_; }
   int consecutive() const { return consecutive_; }  // images the candidate has been confirmed in
   // After confirmation: whether the last image's target tracks were moved onto a
-  // re-detection, in how many images they were, and their largest move there (px).
+  // re-detection, in how many images they were (of how many with all four tracked), and
+  // their largest move there (px).
   bool reanchored() const { return reanchored_; }
   int reanchoredImages() const { return reanchored_images_; }
+  int followedImages() const { return followed_images_; }
   double lastReanchorShiftPx() const { return last_shift_px_; }
 
  private:
@@ -61,6 +63,7 @@ class TargetStartup {
   std::vector<std::uint64_t> corner_ids_;  // the tracker's ids of the corners, in order
   bool reanchored_ = false;
   int reanchored_images_ = 0;
+  int followed_images_ = 0;
   double last_shift_px_ = 0;
   cv::Mat crop_;  // the region searched after confirmation (undistorted when a lens is set)
   void followTarget(const cv::Mat& gray, FeatureTracker& tracker);
