@@ -328,6 +328,21 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
   }
 }
 
+// The humanoid's synthetic tracks until its up-to-scale start has been checking the
+// floor for 5 images (no floor in the image at the start); the next image's index.
+namespace {
+int startUpToScale(const SyntheticTracks& world, PoseEstimator& estimator) {
+  int k = 0, checking = 0;
+  for (; k < 240 && checking < 5; ++k) {
+    estimator.update(withoutTarget(world.frame(k / 30.0)));
+    checking = estimator.checkingPose() ? checking + 1 : 0;
+  }
+  EXPECT_EQ(checking, 5) << estimator.waitingFor();
+  EXPECT_FALSE(estimator.scaleKnown());
+  return k;
+}
+}  // namespace
+
 TEST(PoseEstimator, AnImageNotPlacedKeepsAnUnscaledStart) {
   // The humanoid's head starts up to scale (no floor in the image); one image the
   // landmarks cannot place (its tracks scrambled: PnP fails) must not undo that start
@@ -335,13 +350,8 @@ TEST(PoseEstimator, AnImageNotPlacedKeepsAnUnscaledStart) {
   const SyntheticTracks world("humanoid", 100);
   PoseEstimator estimator(world.camera.K(), world.camera.distortion(),
                           source("camera_height", 1.2));
-  int k = 0, checking = 0;
-  for (; k < 240 && checking < 5; ++k) {
-    estimator.update(withoutTarget(world.frame(k / 30.0)));
-    checking = estimator.checkingPose() ? checking + 1 : 0;
-  }
-  ASSERT_EQ(checking, 5) << estimator.waitingFor();
-  ASSERT_FALSE(estimator.scaleKnown());
+  int k = startUpToScale(world, estimator);
+  ASSERT_FALSE(HasFailure());
   TrackFrame scrambled = withoutTarget(world.frame(k / 30.0));
   std::reverse(scrambled.pixels.begin(), scrambled.pixels.end());
   EXPECT_FALSE(estimator.update(scrambled));
@@ -362,13 +372,8 @@ TEST(PoseEstimator, ASecondOfImagesNotPlacedUndoesAnUnscaledStart) {
   const SyntheticTracks world("humanoid", 100);
   PoseEstimator estimator(world.camera.K(), world.camera.distortion(),
                           source("camera_height", 1.2));
-  int k = 0, checking = 0;
-  for (; k < 240 && checking < 5; ++k) {
-    estimator.update(withoutTarget(world.frame(k / 30.0)));
-    checking = estimator.checkingPose() ? checking + 1 : 0;
-  }
-  ASSERT_EQ(checking, 5) << estimator.waitingFor();
-  ASSERT_FALSE(estimator.scaleKnown());
+  int k = startUpToScale(world, estimator);
+  ASSERT_FALSE(HasFailure());
   int kept = 0;
   for (int i = 0; i < 45 && estimator.initialised(); ++i, ++k) {
     TrackFrame scrambled = withoutTarget(world.frame(k / 30.0));

@@ -10,6 +10,27 @@
 
 using namespace mono_plane_detection;
 
+namespace {
+
+// A wide lens (strong barrel distortion) and the wheeled start turned about the vertical
+// so the target sits off the image centre, where the lens bends most.
+CameraModel barrelLens() {
+  CameraModel camera;
+  camera.k1 = -0.30;
+  camera.k2 = 0.08;
+  return camera;
+}
+
+Pose turnedStart(double yaw_deg) {
+  Pose pose = trajectoryPose(TrajectoryParams(), 0.0);
+  const cv::Matx33d turn =  // about the world's vertical
+      cameraOrientation(yaw_deg * CV_PI / 180, 0, 0) * cameraOrientation(0, 0, 0).t();
+  pose.R = turn * pose.R;
+  return pose;
+}
+
+}  // namespace
+
 TEST(TargetStartup, AddsTheFourCornersOnceConfirmed) {
   const IndoorScene scene = makeRoom(RoomParams());
   const CameraModel camera;
@@ -82,9 +103,7 @@ TEST(TargetStartup, NothingWithoutTheTarget) {
 // the corners come back in raw pixels. Rendered views, exact corners.
 TEST(TargetStartup, LensDistortionIsUndoneBeforeTheSidesAreFitted) {
   const IndoorScene scene = makeRoom(RoomParams());
-  CameraModel camera;
-  camera.k1 = -0.30;
-  camera.k2 = 0.08;
+  const CameraModel camera = barrelLens();
   RenderOptions options;
   options.supersample = 2;
   const SceneRenderer renderer(scene, camera, options);
@@ -92,13 +111,8 @@ TEST(TargetStartup, LensDistortionIsUndoneBeforeTheSidesAreFitted) {
   once.confirm_frames = 1;
   double worst_raw = 0, worst_lens = 0;
   int views = 0;
-  // The target off the image centre, where the lens bends most: the camera turned.
   for (double yaw_deg : {-24.0, -18.0, 0.0, 18.0, 24.0}) {
-    TrajectoryParams path;
-    Pose world_from_camera = trajectoryPose(path, 0.0);
-    const cv::Matx33d turn =  // about the world's vertical
-        cameraOrientation(yaw_deg * CV_PI / 180, 0, 0) * cameraOrientation(0, 0, 0).t();
-    world_from_camera.R = turn * world_from_camera.R;
+    const Pose world_from_camera = turnedStart(yaw_deg);
     const cv::Mat view = renderer.render(world_from_camera);
     FeatureTracker tracker;
     tracker.process(view);
@@ -249,7 +263,9 @@ TEST(TargetStartup, NoReanchorWhenTheDetectionDisagreesOrFails) {
     before = targetTracks(tracker);
     startup.process(view, tracker);
     EXPECT_EQ(startup.reanchored(), redetect);
-    if (redetect) EXPECT_NEAR(startup.lastReanchorShiftPx(), 1.0, 0.1);  // net push left
+    if (redetect) {
+      EXPECT_NEAR(startup.lastReanchorShiftPx(), 1.0, 0.1);  // net push left
+    }
     after = targetTracks(tracker);
     EXPECT_EQ(after[0].uv != before[0].uv, redetect);
     // No target in the image searched (the region blank): nothing moves.
@@ -266,17 +282,11 @@ TEST(TargetStartup, NoReanchorWhenTheDetectionDisagreesOrFails) {
 // raw pixels.
 TEST(TargetStartup, ReanchoringWithLensDistortionGivesRawPixels) {
   const IndoorScene scene = makeRoom(RoomParams());
-  CameraModel camera;
-  camera.k1 = -0.30;
-  camera.k2 = 0.08;
+  const CameraModel camera = barrelLens();
   RenderOptions options;
   options.supersample = 2;
   const SceneRenderer renderer(scene, camera, options);
-  TrajectoryParams path;
-  Pose pose = trajectoryPose(path, 0.0);
-  const cv::Matx33d turn =  // the target off centre, where the lens bends most
-      cameraOrientation(18 * CV_PI / 180, 0, 0) * cameraOrientation(0, 0, 0).t();
-  pose.R = turn * pose.R;
+  const Pose pose = turnedStart(18);
   const cv::Mat view = renderer.render(pose);
   TargetParams once;
   once.confirm_frames = 1;
