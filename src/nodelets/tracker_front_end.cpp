@@ -188,8 +188,6 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     out.warnings.push_back({"info size", why.str()});
   }
   tracker_.process(image);
-  // Paper II-A: until the start-up target is seen, look for it; its corners become
-  // tracked points flagged as target corners.
   // A camera_info for another image size is not this image's camera: its lens would bend
   // the sheet's sides and its focal length misjudge its shape (searched as a photo instead).
   const bool info_fits = info_size_.empty() || info_size_ == image.size();
@@ -197,6 +195,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     target_startup_.setLens(info_fits ? lens_K_ : cv::Matx33d::eye(),
                             info_fits ? lens_D_ : cv::Mat(), info_fits && lens_fisheye_);
   }
+  // Paper II-A: until the start-up target is seen, look for it; its corners become
+  // tracked points flagged as target corners.
   if (params_.detect_target && !target_startup_.found()) {
     // The wait counts from the first image searched (after a reset too: the reset
     // already said why), in image stamps.
