@@ -404,8 +404,11 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  // Both ends connected: an answer published before our subscriber is linked is lost
+  // (seen once with both cores busy: the first image "not answered").
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(sub.getNumPublishers(), 0u);
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 90; ++k) {
@@ -453,8 +456,11 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
       [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_source: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  // Both ends connected: an answer published before our subscriber is linked is lost
+  // (seen once with both cores busy: the first image "not answered").
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(sub.getNumPublishers(), 0u);
   std::optional<cv::Vec3d> previous;
   double worst_step = 0;
   {  // a new broadcaster: let the nodelet's tf listener connect before the first image
@@ -589,8 +595,11 @@ TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
       [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  spinUntil([&] { return tracks.getNumSubscribers() > 0; }, 10.0);
+  // Both ends connected: an answer published before our subscriber is linked is lost
+  // (seen once with both cores busy: the first image "not answered").
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  ASSERT_GT(sub.getNumPublishers(), 0u);
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 96; ++k) {
