@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/tracking/marker_target.h"
 
 namespace mono_plane_detection {
@@ -451,10 +452,6 @@ std::pair<int, double> continuingSide(const cv::Mat& gray, const Quad& q, double
     }
     return sum / (depth - 1);
   };
-  auto median = [](std::vector<double>& v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   std::pair<int, double> worst{-1, 0};
   for (int i = 0; i < 4; ++i) {
     const cv::Point2f a = q[i], b = q[(i + 1) % 4];
@@ -581,9 +578,10 @@ std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double f
 namespace {
 
 // The aspect check. With the focal length known (the nodelet: camera_info), the
-// rectified width/height must be the sheet's (at a focal length within 5 % of it). Unknown (a photo given to detect_target):
-// some focal length from 0.5 to 5 image sizes (a cropped photo has a long one) must make
-// the quadrilateral a rectangle (sides within 9 deg of square) of the sheet's shape.
+// rectified width/height must be the sheet's (at a focal length within 5 % of it).
+// Unknown (a photo given to detect_target): some focal length from 0.5 to 5 image sizes
+// (a cropped photo has a long one) must make the quadrilateral a rectangle (sides within
+// 9 deg of square) of the sheet's shape.
 // Returns the relative aspect error of the best focal length, and its aspect.
 std::pair<double, double> aspectError(const Quad& quad, cv::Size image, double focal_px,
                                       cv::Point2d principal_px, double expected) {
@@ -782,21 +780,16 @@ std::optional<TargetPose> cameraPoseFromTarget(const TargetDetection& detection,
   const std::vector<cv::Point3d> object(map_corners.begin(), map_corners.end());
   const std::vector<cv::Point2d> image(detection.corners.begin(), detection.corners.end());
   cv::Vec3d rvec, tvec;
-  const auto finite = [&] {
-    return cv::checkRange(rvec) && cv::checkRange(tvec);
-  };
   // IPPE returns NaN for some nearly frontal views with a little corner noise (its
   // rotation takes a square root of a rounding-negative number): solved again by the
   // iterative solver, whose planar start is a homography, rather than refused.
-  if (!cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false,
-                    cv::SOLVEPNP_IPPE) ||
-      !finite()) {
-    if (!cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false,
-                      cv::SOLVEPNP_ITERATIVE) ||
-        !finite()) {
-      return std::nullopt;
-    }
+  bool solved = false;
+  for (const int method : {cv::SOLVEPNP_IPPE, cv::SOLVEPNP_ITERATIVE}) {
+    solved = cv::solvePnP(object, image, cv::Mat(K), distortion, rvec, tvec, false, method) &&
+             cv::checkRange(rvec) && cv::checkRange(tvec);
+    if (solved) break;
   }
+  if (!solved) return std::nullopt;
   cv::Matx33d R;
   cv::Rodrigues(rvec, R);
   const Pose camera_from_map{R, tvec};

@@ -10,6 +10,13 @@
 
 namespace mono_plane_detection {
 
+TargetStartup::TargetStartup(const TargetParams& params) : params_(params), follow_params_(params) {
+  // No aspect check in followTarget's region: its focal length and principal point do not
+  // carry over to a crop, and the target is already known: four corners that each land
+  // within confirm_tolerance_px of a confirmed track are its corners.
+  follow_params_.max_aspect_error = std::numeric_limits<double>::infinity();
+}
+
 void TargetStartup::reset() {
   found_ = false;
   consecutive_ = 0;
@@ -106,12 +113,7 @@ void TargetStartup::followTarget(const cv::Mat& gray, FeatureTracker& tracker) {
   if (undistort)  // only the region: the maps give each of its pixels' raw position
     cv::remap(gray, crop_, map1_(roi), map2_(roi), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   const cv::Mat search = undistort ? crop_ : gray(roi);
-  // No aspect check here: its focal length and principal point do not carry over to a
-  // crop, and the target is already known: four corners that each land within
-  // confirm_tolerance_px of a confirmed track are its corners.
-  TargetParams params = params_;
-  params.max_aspect_error = std::numeric_limits<double>::infinity();
-  TargetDetection again = detectConfiguredTarget(search, params);
+  TargetDetection again = detectConfiguredTarget(search, follow_params_);
   if (!again.found) return;  // the tracks stay as they are
   const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
   for (auto& c : again.corners) c += offset;
@@ -149,8 +151,8 @@ std::optional<TargetDetection> TargetStartup::process(const cv::Mat& gray, Featu
     return {};
   }
   const bool undistort = !D_.empty() && !gray.empty();
-  if (undistort) ensureMaps(gray.size());
   if (undistort) {
+    ensureMaps(gray.size());
     // Replicated, not black, beyond the raw image: a black fill would be a dark surround.
     cv::remap(gray, undistorted_, map1_, map2_, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
     focal_px = K_(0, 0);

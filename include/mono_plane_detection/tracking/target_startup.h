@@ -23,7 +23,7 @@ namespace mono_plane_detection {
 
 class TargetStartup {
  public:
-  explicit TargetStartup(const TargetParams& params = TargetParams()) : params_(params) {}
+  explicit TargetStartup(const TargetParams& params = TargetParams());
 
   // Call after tracker.process(gray), on every image. Returns the detection on the image
   // where the target is confirmed (once); nothing before and after (after, the tracked
@@ -56,6 +56,7 @@ class TargetStartup {
 
  private:
   TargetParams params_;
+  TargetParams follow_params_;  // params_ without the aspect check (followTarget's crops)
   bool found_ = false;
   int consecutive_ = 0;
   cv::Mat previous_;  // the image of the last detection, for Lucas-Kanade
