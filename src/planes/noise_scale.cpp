@@ -48,11 +48,12 @@ NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model
     ensure(k - 1);
     sum += residuals[k - 1];
     if (k < min_inliers) continue;
-    const double sigma2 = sum / (2.0 * k - model_dof);
+    // r_k^2 > stop^2 sigma^2 with sigma^2 = sum / (2k - dof), without the division.
+    const double dof = 2.0 * k - model_dof;
     *cut = residuals[k - 1];
-    if (k == n) return {std::sqrt(sigma2), k};
+    if (k == n) return {std::sqrt(sum / dof), k};
     ensure(k);
-    if (residuals[k] > stop2 * sigma2) return {std::sqrt(sigma2), k};
+    if (residuals[k] * dof > stop2 * sum) return {std::sqrt(sum / dof), k};
   }
   return {};
 }
