@@ -186,11 +186,17 @@ struct Energy {
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
   // width_cost: widthCost(p), computed once per plane (a logarithm per point otherwise).
+  // In squared pixels (no square root; one division: |H a - w b|^2 / w^2): the
+  // assignment, split and merge evaluate it for every point and plane, several times.
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
-    const double u = transferError(p.H, a, b) / p.noise_px;
-    if (!std::isfinite(u) || u * p.noise_px >= p.threshold_px) return k2;
-    return std::min(u * u + width_cost, k2);
+    const cv::Matx33d& H = p.H;
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
+    const double e2 = (dx * dx + dy * dy) / (w * w);  // transfer error^2
+    if (!(std::abs(w) >= 1e-12) || !(e2 < p.threshold_px * p.threshold_px)) return k2;
+    return std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
   }
   double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
