@@ -30,6 +30,24 @@ std::vector<cv::Point2d> select(const std::vector<cv::Point2d>& p, const std::ve
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
+// The transfer error squared, |H a - w b|^2 / w^2 (one division, no square root: the
+// weights, the criterion and the planes' scales need only its square); infinity when H
+// sends a to infinity.
+double squaredTransfer(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b) {
+  const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+  if (!(std::abs(w) >= 1e-12)) return std::numeric_limits<double>::infinity();
+  const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
+  const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
+  return (dx * dx + dy * dy) / (w * w);
+}
+
+// Cauchy weight 1 / (1 + (r / scale)^2) of a point's transfer error r (0 at infinity).
+double cauchyWeight(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b,
+                    double scale) {
+  const double u2 = squaredTransfer(H, a, b) / (scale * scale);
+  return std::isfinite(u2) ? 1.0 / (1.0 + u2) : 0.0;
+}
+
 // Points' coordinates in separate arrays, for counting votes in vector instructions.
 struct PointArrays {
   std::vector<double> ax, ay, bx, by;
@@ -150,10 +168,7 @@ bool refitAmong(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv:
     std::vector<double> weights;
     if (params.robust_refit) {
       weights.reserve(inliers.size());
-      for (int i : inliers) {
-        const double r = transferError(H, view1[i], view2[i]) / threshold_px;
-        weights.push_back(1.0 / (1.0 + r * r));
-      }
+      for (int i : inliers) weights.push_back(cauchyWeight(H, view1[i], view2[i], threshold_px));
     }
     const auto fitted = fitHomography(select(view1, inliers), select(view2, inliers), weights);
     if (!fitted) return false;
@@ -186,16 +201,12 @@ struct Energy {
   double plane_cost;  // label cost of one plane
   double fixed_threshold_px;  // > 0: the user's threshold, every plane's
   // width_cost: widthCost(p), computed once per plane (a logarithm per point otherwise).
-  // In squared pixels (no square root; one division: |H a - w b|^2 / w^2): the
-  // assignment, split and merge evaluate it for every point and plane, several times.
+  // On the squared transfer error (no square root): the assignment, split and merge
+  // evaluate it for every point and plane, several times.
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
-    const cv::Matx33d& H = p.H;
-    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
-    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
-    const double e2 = (dx * dx + dy * dy) / (w * w);  // transfer error^2
-    if (!(std::abs(w) >= 1e-12) || !(e2 < p.threshold_px * p.threshold_px)) return k2;
+    const double e2 = squaredTransfer(p.H, a, b);
+    if (!(e2 < p.threshold_px * p.threshold_px)) return k2;
     return std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
   }
   double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
@@ -213,11 +224,11 @@ struct Energy {
 void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1,
                    const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
                    const Energy& energy, const PlaneParams& params) {
-  std::vector<double> r;
-  r.reserve(among.size());
-  for (int i : among) r.push_back(transferError(plane.H, view1[i], view2[i]));
+  std::vector<double> r2;  // squared residuals: the same order statistics
+  r2.reserve(among.size());
+  for (int i : among) r2.push_back(squaredTransfer(plane.H, view1[i], view2[i]));
   const double sigma = energy.sigma;
-  const NoiseScale s = medianScale(r, sigma, params.noise.tail_sigmas);
+  const NoiseScale s = medianScaleSquared(r2, sigma, params.noise.tail_sigmas);
   plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
   // A fixed threshold stays every plane's; the scale still counts the plane's cost in its
   // own units (an implied scale smaller than the data's would make splitting pay).
@@ -473,10 +484,8 @@ bool refineAssignment(std::vector<HomographyPlane>& planes, const std::vector<cv
       // Cauchy weights at the plane's own scale: a heavy tail does not pull the fit.
       std::vector<double> w;
       if (params.robust_refit) {
-        for (int i : members[k]) {
-          const double u = transferError(planes[k].H, view1[i], view2[i]) / (2.0 * planes[k].noise_px);
-          w.push_back(std::isfinite(u) ? 1.0 / (1.0 + u * u) : 0.0);
-        }
+        for (int i : members[k])
+          w.push_back(cauchyWeight(planes[k].H, view1[i], view2[i], 2.0 * planes[k].noise_px));
       }
       if (auto H = fitHomography(select(view1, members[k]), select(view2, members[k]), w))
         planes[k].H = *H;
@@ -518,10 +527,8 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   bool replaced = false;
   for (HomographyPlane& plane : planes) {
     std::vector<double> w;
-    for (int i : plane.inliers) {
-      const double r = transferError(plane.H, view1[i], view2[i]) / (2.0 * plane.noise_px);
-      w.push_back(std::isfinite(r) ? 1.0 / (1.0 + r * r) : 0.0);
-    }
+    for (int i : plane.inliers)
+      w.push_back(cauchyWeight(plane.H, view1[i], view2[i], 2.0 * plane.noise_px));
     const auto Hc = fitInducedHomography(A, e, select(view1, plane.inliers),
                                          select(view2, plane.inliers), w);
     if (!Hc) continue;
@@ -684,13 +691,19 @@ double membershipSigmas(double tail_ratio, const PlaneParams& params) {
 double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                         const std::vector<cv::Point2d>& view2, size_t kth, double bound,
                         std::vector<double>& r) {
-  r.resize(view1.size());
+  const size_t n = view1.size();
+  r.resize(n);
   size_t below = 0;
   const double bound2 = bound * bound;
-  for (size_t i = 0; i < view1.size(); ++i) {
-    // Squared: the same order, one square root at the end.
-    r[i] = transferErrorSquared(H, view1[i], view2[i]);
-    below += r[i] < bound2;
+  for (size_t b0 = 0; b0 < n; b0 += kVoteBlock) {
+    const size_t b1 = std::min(n, b0 + kVoteBlock);
+    for (size_t i = b0; i < b1; ++i) {
+      // Squared: the same order, one square root at the end.
+      r[i] = transferErrorSquared(H, view1[i], view2[i]);
+      below += r[i] < bound2;
+    }
+    // Even every point left below the bound leaves at most k below it: known already.
+    if (below + (n - b1) <= kth) return std::numeric_limits<double>::infinity();
   }
   if (below <= kth) return std::numeric_limits<double>::infinity();
   std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());

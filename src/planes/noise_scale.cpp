@@ -110,6 +110,14 @@ std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv
 
 NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, double cut_sigmas,
                        int iterations) {
+  std::vector<double> squared;
+  squared.reserve(residuals.size());
+  for (double r : residuals) squared.push_back(r * r);
+  return medianScaleSquared(squared, sigma0, cut_sigmas, iterations);
+}
+
+NoiseScale medianScaleSquared(const std::vector<double>& residuals, double sigma0,
+                              double cut_sigmas, int iterations) {
   if (!(sigma0 > 0) || !(cut_sigmas > 0)) return {};
   // The median of Rayleigh(sigma) residuals below c sigma is sigma sqrt(-2 ln(1 - F/2)),
   // F = 1 - exp(-c^2 / 2) the share below the cut (1.1774 sigma for a wide cut).
@@ -122,12 +130,13 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
   std::vector<double> sorted, rest;
   sorted.reserve(residuals.size());
   rest.reserve(residuals.size());
+  // (Squared residuals throughout: cut and bound squared, the order statistics' roots.)
   double bound = -std::numeric_limits<double>::infinity();  // sorted: every finite r < bound
   for (double r : residuals)
     if (std::isfinite(r)) rest.push_back(r);
   NoiseScale s{sigma0, 0};
   for (int it = 0; it < iterations; ++it) {
-    const double cut = cut_sigmas * s.sigma_px;
+    const double cut = cut_sigmas * s.sigma_px * cut_sigmas * s.sigma_px;
     if (cut > bound) {  // the residuals in [bound, cut) join the sorted ones, after them
       const auto mid =
           std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
@@ -140,10 +149,10 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
     const size_t in = static_cast<size_t>(std::lower_bound(sorted.begin(), sorted.end(), cut) -
                                           sorted.begin());  // r < cut
     if (in == 0) return {};
-    const double median = sorted[in / 2];
+    const double median = std::sqrt(sorted[in / 2]);
     const double next = median / median_in_sigmas;
     const bool converged = std::abs(next - s.sigma_px) < 1e-3 * s.sigma_px;
-    const double q90 = sorted[(in * 9) / 10];
+    const double q90 = std::sqrt(sorted[(in * 9) / 10]);
     s = {next, static_cast<int>(in), median > 0 ? q90 / median : 0.0};
     if (converged || !(next > 0)) break;
   }
@@ -248,8 +257,8 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   // MSSE stops at the first gap, which heavy-tailed noise puts inside the inliers: the
   // best plane's residuals under a truncated Rayleigh model (medianScale, cut at
   // tail_sigmas) take the tail in as far as it is continuous.
-  const NoiseScale t = medianScale(transferResiduals(*best_h, view1, view2), best.sigma_px,
-                                   params.tail_sigmas, 30);
+  const NoiseScale t = medianScaleSquared(squaredResiduals(*best_h, view1, view2), best.sigma_px,
+                                          params.tail_sigmas, 30);
   if (t.inliers >= params.min_inliers) best = t;
   best.sigma_px = std::clamp(best.sigma_px, params.min_sigma_px, params.max_sigma_px);
   return best;
