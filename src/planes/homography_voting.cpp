@@ -111,8 +111,8 @@ BlockCount countWhileItCanWin(const cv::Matx33d& H, const PointArrays& p, double
   return countWhileItCanWin(H, p, t2, can_win, [](int, size_t) { return false; });
 }
 template <class CanWin, class BailOut>
-BlockCount countWhileItCanWin(const cv::Matx33d& H, const PointArrays& p, double t2,
-                              CanWin can_win, BailOut bail_out) {
+BlockCount countWhileItCanWin(const cv::Matx33d& H, const PointArrays& p, double t2, CanWin can_win,
+                              BailOut bail_out) {
   BlockCount count;
   const size_t m = p.size();
   size_t left = m;
@@ -120,8 +120,7 @@ BlockCount countWhileItCanWin(const cv::Matx33d& H, const PointArrays& p, double
     const size_t b1 = std::min(m, b0 + kVoteBlock);
     count.votes += votesInBlock(H, p, b0, b1, t2);
     left -= b1 - b0;
-    if (left > 0 && (!can_win(count.votes + static_cast<int>(left)) ||
-                     bail_out(count.votes, b1))) {
+    if (left > 0 && (!can_win(count.votes + static_cast<int>(left)) || bail_out(count.votes, b1))) {
       count.complete = false;
       count.votes += static_cast<int>(left);
       break;

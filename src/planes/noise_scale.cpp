@@ -166,9 +166,9 @@ double asscScore(const NoiseScale& s) {
 }
 
 // One refit step of refine: the homography least squares gives on an inlier set, its
-// squared residuals, and their MSSE scale and (squared) cut. It depends on the inlier set only, and the
-// candidates of one image pair mostly converge to the same few sets (the dominant
-// plane's), so each set's step is computed once per estimate and looked up after.
+// squared residuals, and their MSSE scale and (squared) cut. It depends on the inlier set only, and
+// the candidates of one image pair mostly converge to the same few sets (the dominant plane's), so
+// each set's step is computed once per estimate and looked up after.
 struct RefitStep {
   std::vector<char> in;
   bool fitted = false;
