@@ -11,7 +11,9 @@ namespace mono_plane_detection {
 
 namespace {
 
-// msseScale, also giving the largest inlier residual (the inlier set's cut).
+// msseScale on squared residuals (the same order and stop, without a square root per
+// residual and per inlier count: the pilot runs 55-73 of these per image pair), also
+// giving the largest inlier's squared residual (the inlier set's cut).
 // expected: about how many inliers there will be (the last estimate's on a refit), 0
 // unknown; only how much is sorted first depends on it, not the result.
 NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model_dof,
@@ -40,16 +42,18 @@ NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model
       sorted = more;
     }
   };
+  const double stop2 = stop_sigmas * stop_sigmas;
   double sum = 0.0;
   for (int k = 1; k <= n; ++k) {
     ensure(k - 1);
-    sum += residuals[k - 1] * residuals[k - 1];
+    sum += residuals[k - 1];
     if (k < min_inliers) continue;
-    const double sigma = std::sqrt(sum / (2.0 * k - model_dof));
+    // r_k^2 > stop^2 sigma^2 with sigma^2 = sum / (2k - dof), without the division.
+    const double dof = 2.0 * k - model_dof;
     *cut = residuals[k - 1];
-    if (k == n) return {sigma, k};
+    if (k == n) return {std::sqrt(sum / dof), k};
     ensure(k);
-    if (residuals[k] > stop_sigmas * sigma) return {sigma, k};
+    if (residuals[k] * dof > stop2 * sum) return {std::sqrt(sum / dof), k};
   }
   return {};
 }
@@ -58,9 +62,31 @@ NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model
 
 NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_dof,
                      double stop_sigmas) {
+  for (double& r : residuals) r *= r;
   double cut = 0.0;
   return msseWithCut(std::move(residuals), min_inliers, model_dof, stop_sigmas, &cut);
 }
+
+namespace {
+
+// Squared transfer residuals (infinity where H sends a point to infinity): what MSSE
+// sorts and cuts.
+std::vector<double> squaredResiduals(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
+                                     const std::vector<cv::Point2d>& view2) {
+  std::vector<double> r(view1.size());
+  for (size_t i = 0; i < view1.size(); ++i) {
+    const cv::Point2d& a = view1[i];
+    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
+    // |H a - w b|^2 / w^2: transferResiduals' arithmetic, squared (one division).
+    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - view2[i].x * w;
+    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - view2[i].y * w;
+    r[i] = std::abs(w) < 1e-12 ? std::numeric_limits<double>::infinity()
+                               : (dx * dx + dy * dy) / (w * w);
+  }
+  return r;
+}
+
+}  // namespace
 
 std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                                       const std::vector<cv::Point2d>& view2) {
@@ -84,6 +110,14 @@ std::vector<double> transferResiduals(const cv::Matx33d& H, const std::vector<cv
 
 NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, double cut_sigmas,
                        int iterations) {
+  std::vector<double> squared;
+  squared.reserve(residuals.size());
+  for (double r : residuals) squared.push_back(r * r);
+  return medianScaleSquared(squared, sigma0, cut_sigmas, iterations);
+}
+
+NoiseScale medianScaleSquared(const std::vector<double>& residuals, double sigma0,
+                              double cut_sigmas, int iterations) {
   if (!(sigma0 > 0) || !(cut_sigmas > 0)) return {};
   // The median of Rayleigh(sigma) residuals below c sigma is sigma sqrt(-2 ln(1 - F/2)),
   // F = 1 - exp(-c^2 / 2) the share below the cut (1.1774 sigma for a wide cut).
@@ -96,12 +130,13 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
   std::vector<double> sorted, rest;
   sorted.reserve(residuals.size());
   rest.reserve(residuals.size());
+  // (Squared residuals throughout: cut and bound squared, the order statistics' roots.)
   double bound = -std::numeric_limits<double>::infinity();  // sorted: every finite r < bound
   for (double r : residuals)
     if (std::isfinite(r)) rest.push_back(r);
   NoiseScale s{sigma0, 0};
   for (int it = 0; it < iterations; ++it) {
-    const double cut = cut_sigmas * s.sigma_px;
+    const double cut = cut_sigmas * s.sigma_px * cut_sigmas * s.sigma_px;
     if (cut > bound) {  // the residuals in [bound, cut) join the sorted ones, after them
       const auto mid =
           std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
@@ -114,10 +149,10 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
     const size_t in = static_cast<size_t>(std::lower_bound(sorted.begin(), sorted.end(), cut) -
                                           sorted.begin());  // r < cut
     if (in == 0) return {};
-    const double median = sorted[in / 2];
+    const double median = std::sqrt(sorted[in / 2]);
     const double next = median / median_in_sigmas;
     const bool converged = std::abs(next - s.sigma_px) < 1e-3 * s.sigma_px;
-    const double q90 = sorted[(in * 9) / 10];
+    const double q90 = std::sqrt(sorted[(in * 9) / 10]);
     s = {next, static_cast<int>(in), median > 0 ? q90 / median : 0.0};
     if (converged || !(next > 0)) break;
   }
@@ -131,9 +166,9 @@ double asscScore(const NoiseScale& s) {
 }
 
 // One refit step of refine: the homography least squares gives on an inlier set, its
-// residuals, and their MSSE scale and cut. It depends on the inlier set only, and the
-// candidates of one image pair mostly converge to the same few sets (the dominant
-// plane's), so each set's step is computed once per estimate and looked up after.
+// squared residuals, and their MSSE scale and (squared) cut. It depends on the inlier set only, and
+// the candidates of one image pair mostly converge to the same few sets (the dominant plane's), so
+// each set's step is computed once per estimate and looked up after.
 struct RefitStep {
   std::vector<char> in;
   bool fitted = false;
@@ -160,7 +195,7 @@ const RefitStep& refitStep(const std::vector<char>& in, const std::vector<cv::Po
   if (const auto refit = fitHomography(a, b)) {
     step.fitted = true;
     step.H = *refit;
-    step.r = transferResiduals(*refit, view1, view2);
+    step.r = squaredResiduals(*refit, view1, view2);
     step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut,
                              static_cast<size_t>(std::count(in.begin(), in.end(), 1)));
   }
@@ -168,8 +203,8 @@ const RefitStep& refitStep(const std::vector<char>& in, const std::vector<cv::Po
   return memo.back();
 }
 
-// Refits H on the inlier set of `scale` (residuals r under H, cut: its largest inlier
-// residual) and estimates again while ASSC's score improves. Each round's residuals and
+// Refits H on the inlier set of `scale` (squared residuals r under H, cut: its largest
+// inlier's) and estimates again while ASSC's score improves. Each round's residuals and
 // cut come from the previous one (recomputing them took a third of the estimate).
 NoiseScale refine(cv::Matx33d& H, NoiseScale scale, std::vector<double> r, double cut,
                   const std::vector<cv::Point2d>& view1, const std::vector<cv::Point2d>& view2,
@@ -208,7 +243,7 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   std::optional<cv::Matx33d> best_h;
   std::vector<RefitStep> memo;
   for (cv::Matx33d H : candidates) {
-    std::vector<double> r = transferResiduals(H, view1, view2);
+    std::vector<double> r = squaredResiduals(H, view1, view2);
     double cut = 0.0;
     NoiseScale s = msseWithCut(r, params.min_inliers, 8, params.stop_sigmas, &cut);
     if (s.inliers == 0 || !(s.sigma_px > 0)) continue;
@@ -222,8 +257,8 @@ NoiseScale estimateNoiseScale(const std::vector<cv::Matx33d>& candidates,
   // MSSE stops at the first gap, which heavy-tailed noise puts inside the inliers: the
   // best plane's residuals under a truncated Rayleigh model (medianScale, cut at
   // tail_sigmas) take the tail in as far as it is continuous.
-  const NoiseScale t = medianScale(transferResiduals(*best_h, view1, view2), best.sigma_px,
-                                   params.tail_sigmas, 30);
+  const NoiseScale t = medianScaleSquared(squaredResiduals(*best_h, view1, view2), best.sigma_px,
+                                          params.tail_sigmas, 30);
   if (t.inliers >= params.min_inliers) best = t;
   best.sigma_px = std::clamp(best.sigma_px, params.min_sigma_px, params.max_sigma_px);
   return best;

@@ -46,6 +46,21 @@ TEST(MedianScale, IsTheRayleighScaleAndIgnoresFarResiduals) {
   EXPECT_EQ(medianScale({100.0}, 1.0, 5.0).inliers, 0);  // nothing under the cut
 }
 
+TEST(MedianScaleSquared, GivesTheScaleOfTheResidualsFromTheirSquares) {
+  const std::vector<double> r = residuals(400, 300, 1.5, 4);
+  std::vector<double> r2;
+  for (double x : r) r2.push_back(x * x);
+  r2.push_back(INFINITY);  // ignored, as in medianScale
+  const NoiseScale s = medianScaleSquared(r2, 3.0, 5.0);
+  EXPECT_NEAR(s.sigma_px, 1.5, 0.2);
+  const NoiseScale t = medianScale(r, 3.0, 5.0);
+  EXPECT_NEAR(s.sigma_px, t.sigma_px, 1e-9);
+  EXPECT_EQ(s.inliers, t.inliers);
+  EXPECT_NEAR(s.tail_ratio, t.tail_ratio, 1e-9);
+  // Rayleigh: the 90th over the 50th percentile is sqrt(ln 10 / ln 2) = 1.82.
+  EXPECT_NEAR(s.tail_ratio, 1.82, 0.2);
+}
+
 TEST(EstimateNoiseScale, RecoversTheNoiseOfASyntheticPair) {
   for (double noise : {0.3, 1.0}) {
     TwoViewSceneParams sp;

@@ -34,6 +34,10 @@ NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_d
 // cut. {0, 0} when sigma0 or cut_sigmas is not positive or no residual is under the cut.
 NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, double cut_sigmas,
                        int iterations = 30);
+// medianScale on squared residuals (the same order statistics without a square root per
+// residual: each plane's scale is measured several times per image pair).
+NoiseScale medianScaleSquared(const std::vector<double>& squared_residuals, double sigma0,
+                              double cut_sigmas, int iterations = 30);
 
 // The noise scale of an image pair from candidate homographies (view 1 -> view 2): each
 // candidate's residuals get msseScale, refitted on its inlier set while that improves the
