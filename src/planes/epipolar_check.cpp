@@ -206,8 +206,10 @@ int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& 
   int merges = 0;
   while (planes.size() >= 2) {
     const size_t count = planes.size();
-    // Each plane's induced fit at its own scale, and whether it pays for itself.
+    // Each plane's induced fit at its own scale, its points' costs under it, and whether
+    // it pays for itself.
     std::vector<HomographyPlane> induced(planes);
+    std::vector<std::vector<double>> own(count);
     std::vector<char> pays(count, 0);
     for (size_t k = 0; k < count; ++k) {
       const std::vector<int>& idx = planes[k].inliers;
@@ -217,8 +219,9 @@ int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& 
       if (!H) continue;
       induced[k].H = *H;
       criterion.measure(induced[k], idx);
+      own[k] = criterion.costs(induced[k], idx);
       double gain = -criterion.label_cost;
-      for (int i : idx) gain += criterion.outlier_cost - criterion.cost(induced[k], i);
+      for (double c : own[k]) gain += criterion.outlier_cost - c;
       pays[k] = gain > 0.0;
     }
     double best_gain = 0.0;
@@ -227,31 +230,36 @@ int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& 
     for (size_t i = 0; i < count; ++i) {
       for (size_t j = i + 1; j < count; ++j) {
         if (!pays[i] || !pays[j]) continue;
-        // The two pieces' points, each with its piece; every point keeps its cheapest label
-        // either way (another plane, or none).
-        std::vector<int> both = planes[i].inliers, piece(planes[i].inliers.size(), 0);
-        both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        piece.resize(both.size(), 1);
+        // The two pieces' points; every point keeps its cheapest label either way (another
+        // plane, or none).
         const size_t of[2] = {i, j};
+        std::vector<int> both = planes[i].inliers;
+        both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
+        const size_t ni = planes[i].inliers.size();
         std::vector<double> others(both.size(), criterion.outlier_cost), scale, residual;
+        for (size_t m = 0; m < count; ++m) {
+          if (m == i || m == j) continue;
+          const std::vector<double> c = criterion.costs(planes[m], both);
+          for (size_t q = 0; q < both.size(); ++q) others[q] = std::min(others[q], c[q]);
+        }
         double separate = criterion.label_cost;
         for (size_t q = 0; q < both.size(); ++q) {
-          for (size_t m = 0; m < count; ++m)
-            if (m != i && m != j)
-              others[q] = std::min(others[q], criterion.cost(planes[m], both[q]));
-          const HomographyPlane& own = induced[of[piece[q]]];
-          separate += std::min(others[q], criterion.cost(own, both[q]));
-          scale.push_back(own.noise_px);
-          residual.push_back(transferError(own.H, view1[both[q]], view2[both[q]]));
+          const size_t p = of[q < ni ? 0 : 1];
+          separate += std::min(others[q], own[p][q < ni ? q : q - ni]);
+          scale.push_back(induced[p].noise_px);
+          residual.push_back(transferError(induced[p].H, view1[both[q]], view2[both[q]]));
         }
         const auto H =
             fitInducedRobust(H1, e2, pick(view1, both), pick(view2, both), scale, residual);
         if (!H) continue;
+        // The union's homography, each piece's points at that piece's own scale.
         double together = 0.0;
-        for (size_t q = 0; q < both.size() && together < separate; ++q) {
-          HomographyPlane m = induced[of[piece[q]]];  // the piece's own scale
-          m.H = *H;
-          together += std::min(others[q], criterion.cost(m, both[q]));
+        for (int k = 0; k < 2; ++k) {
+          HomographyPlane piece = induced[of[k]];
+          piece.H = *H;
+          const std::vector<double> c = criterion.costs(piece, planes[of[k]].inliers);
+          for (size_t q = 0; q < c.size(); ++q)
+            together += std::min(others[k == 0 ? q : ni + q], c[q]);
         }
         if (separate - together > best_gain) {
           best_gain = separate - together;

@@ -513,8 +513,12 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   // Pieces of one 3D plane, each at its own measured scale (a fixed threshold keeps the
   // old behaviour): planes/epipolar_check.h.
   if (energy.fixed_threshold_px > 0.0) return;
-  const PlaneCriterion criterion{[&](const HomographyPlane& p, int i) {
-                                   return energy.point(p, view1[i], view2[i], energy.widthCost(p));
+  const PlaneCriterion criterion{[&](const HomographyPlane& p, const std::vector<int>& idx) {
+                                   std::vector<double> c;
+                                   const double width = energy.widthCost(p);
+                                   for (int i : idx)
+                                     c.push_back(energy.point(p, view1[i], view2[i], width));
+                                   return c;
                                  },
                                  [&](HomographyPlane& p, const std::vector<int>& idx) {
                                    setPlaneNoise(p, view1, view2, idx, energy, params);

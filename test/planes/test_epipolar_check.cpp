@@ -183,15 +183,20 @@ struct MiniCriterion {
   const std::vector<cv::Point2d>& a;
   const std::vector<cv::Point2d>& b;
   double sigma;
+  double cost(const HomographyPlane& p, int i) const {
+    const double r = transferError(p.H, a[i], b[i]);
+    if (!(r < p.threshold_px)) return 64.0;
+    const double u = r / p.noise_px;
+    return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), 64.0);
+  }
   PlaneCriterion make() const {
     PlaneCriterion c;
     c.outlier_cost = 64.0;
     c.label_cost = 24.0 * std::log(static_cast<double>(a.size()));
-    c.cost = [this](const HomographyPlane& p, int i) {
-      const double r = transferError(p.H, a[i], b[i]);
-      if (!(r < p.threshold_px)) return 64.0;
-      const double u = r / p.noise_px;
-      return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), 64.0);
+    c.costs = [this](const HomographyPlane& p, const std::vector<int>& idx) {
+      std::vector<double> out;
+      for (int i : idx) out.push_back(cost(p, i));
+      return out;
     };
     c.measure = [this](HomographyPlane& p, const std::vector<int>& idx) {
       std::vector<double> r;
@@ -200,13 +205,13 @@ struct MiniCriterion {
       p.noise_px = std::clamp(r[r.size() / 2] / 1.1774, sigma, 4.0 * sigma);  // Rayleigh median
       p.threshold_px = 8.0 * p.noise_px;
     };
-    c.assign = [this, c](std::vector<HomographyPlane>& planes) {
+    c.assign = [this](std::vector<HomographyPlane>& planes) {
       for (HomographyPlane& p : planes) p.inliers.clear();
       for (size_t i = 0; i < a.size(); ++i) {
         double best = 64.0;
         HomographyPlane* to = nullptr;
         for (HomographyPlane& p : planes) {
-          const double e = c.cost(p, static_cast<int>(i));
+          const double e = cost(p, static_cast<int>(i));
           if (e < best) {
             best = e;
             to = &p;

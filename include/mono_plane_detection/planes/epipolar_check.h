@@ -67,8 +67,8 @@ std::optional<cv::Matx33d> fitInducedRobust(const cv::Matx33d& H1, const cv::Vec
 // The terms of the segmentation's criterion (planes/homography_voting.cpp) that
 // mergeInducedPieces uses.
 struct PlaneCriterion {
-  // A point's cost under a plane at the plane's own scale (outlier_cost at most).
-  std::function<double(const HomographyPlane&, int)> cost;
+  // The points' costs under a plane at the plane's own scale (outlier_cost at most).
+  std::function<std::vector<double>(const HomographyPlane&, const std::vector<int>&)> costs;
   // The plane's noise scale and threshold from its residuals over these points.
   std::function<void(HomographyPlane&, const std::vector<int>&)> measure;
   // Every point to its cheapest plane; planes that do not pay dropped.
