@@ -5,6 +5,7 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
 namespace mono_plane_detection {
@@ -164,6 +165,123 @@ std::optional<cv::Matx33d> fitInducedHomography(const cv::Matx33d& H1, const cv:
   const double norm = cv::norm(out);
   if (!(norm > 0.0) || !std::isfinite(norm)) return std::nullopt;
   return out * (1.0 / norm);
+}
+
+std::optional<cv::Matx33d> fitInducedRobust(const cv::Matx33d& H1, const cv::Vec3d& e2,
+                                            const std::vector<cv::Point2d>& from,
+                                            const std::vector<cv::Point2d>& to,
+                                            const std::vector<double>& scale_px,
+                                            const std::vector<double>& residual_px, int rounds) {
+  const size_t n = from.size();
+  if (to.size() != n || scale_px.size() != n || residual_px.size() != n) return std::nullopt;
+  auto weight = [](double r, double s) {
+    const double u = r / (2.0 * s);
+    return std::isfinite(u) && s > 0.0 ? 1.0 / ((1.0 + u * u) * s * s) : 0.0;
+  };
+  std::vector<double> w(n);
+  for (size_t i = 0; i < n; ++i) w[i] = weight(residual_px[i], scale_px[i]);
+  std::optional<cv::Matx33d> H;
+  for (int round = 0; round < std::max(1, rounds); ++round) {
+    H = fitInducedHomography(H1, e2, from, to, w);
+    if (!H) return std::nullopt;
+    for (size_t i = 0; i < n; ++i) w[i] = weight(transferError(*H, from[i], to[i]), scale_px[i]);
+  }
+  return H;
+}
+
+namespace {
+
+std::vector<cv::Point2d> pick(const std::vector<cv::Point2d>& p, const std::vector<int>& idx) {
+  std::vector<cv::Point2d> out;
+  out.reserve(idx.size());
+  for (int i : idx) out.push_back(p[i]);
+  return out;
+}
+
+}  // namespace
+
+int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& H1,
+                       const cv::Vec3d& e2, const std::vector<cv::Point2d>& view1,
+                       const std::vector<cv::Point2d>& view2, const PlaneCriterion& criterion) {
+  int merges = 0;
+  while (planes.size() >= 2) {
+    const size_t count = planes.size();
+    // Each plane's induced fit at its own scale, its points' costs under it, and whether
+    // it pays for itself.
+    std::vector<HomographyPlane> induced(planes);
+    std::vector<std::vector<double>> own(count);
+    std::vector<char> pays(count, 0);
+    for (size_t k = 0; k < count; ++k) {
+      const std::vector<int>& idx = planes[k].inliers;
+      std::vector<double> r, s(idx.size(), planes[k].noise_px);
+      for (int i : idx) r.push_back(transferError(planes[k].H, view1[i], view2[i]));
+      const auto H = fitInducedRobust(H1, e2, pick(view1, idx), pick(view2, idx), s, r, 1);
+      if (!H) continue;
+      induced[k].H = *H;
+      criterion.measure(induced[k], idx);
+      own[k] = criterion.costs(induced[k], idx);
+      double gain = -criterion.label_cost;
+      for (double c : own[k]) gain += criterion.outlier_cost - c;
+      pays[k] = gain > 0.0;
+    }
+    double best_gain = 0.0;
+    size_t bi = 0, bj = 0;
+    cv::Matx33d best_H;
+    for (size_t i = 0; i < count; ++i) {
+      for (size_t j = i + 1; j < count; ++j) {
+        if (!pays[i] || !pays[j]) continue;
+        // The two pieces' points; every point keeps its cheapest label either way (another
+        // plane, or none).
+        const size_t of[2] = {i, j};
+        std::vector<int> both = planes[i].inliers;
+        both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
+        const size_t ni = planes[i].inliers.size();
+        std::vector<double> others(both.size(), criterion.outlier_cost), scale, residual;
+        for (size_t m = 0; m < count; ++m) {
+          if (m == i || m == j) continue;
+          const std::vector<double> c = criterion.costs(planes[m], both);
+          for (size_t q = 0; q < both.size(); ++q) others[q] = std::min(others[q], c[q]);
+        }
+        double separate = criterion.label_cost;
+        for (size_t q = 0; q < both.size(); ++q) {
+          const size_t p = of[q < ni ? 0 : 1];
+          separate += std::min(others[q], own[p][q < ni ? q : q - ni]);
+          scale.push_back(induced[p].noise_px);
+          residual.push_back(transferError(induced[p].H, view1[both[q]], view2[both[q]]));
+        }
+        const auto H =
+            fitInducedRobust(H1, e2, pick(view1, both), pick(view2, both), scale, residual);
+        if (!H) continue;
+        // The union's homography, each piece's points at that piece's own scale.
+        double together = 0.0;
+        for (int k = 0; k < 2; ++k) {
+          HomographyPlane piece = induced[of[k]];
+          piece.H = *H;
+          const std::vector<double> c = criterion.costs(piece, planes[of[k]].inliers);
+          for (size_t q = 0; q < c.size(); ++q)
+            together += std::min(others[k == 0 ? q : ni + q], c[q]);
+        }
+        if (separate - together > best_gain) {
+          best_gain = separate - together;
+          bi = i;
+          bj = j;
+          best_H = *H;
+        }
+      }
+    }
+    if (best_gain <= 0.0) break;
+    HomographyPlane& merged = planes[bi];
+    merged.H = best_H;
+    merged.inliers.insert(merged.inliers.end(), planes[bj].inliers.begin(),
+                          planes[bj].inliers.end());
+    std::sort(merged.inliers.begin(), merged.inliers.end());
+    merged.noise_px = std::max(merged.noise_px, planes[bj].noise_px);
+    criterion.measure(merged, merged.inliers);
+    planes.erase(planes.begin() + static_cast<long>(bj));
+    criterion.assign(planes);
+    ++merges;
+  }
+  return merges;
 }
 
 }  // namespace mono_plane_detection

@@ -540,9 +540,26 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
       replaced = true;
     }
   }
-  if (!replaced) return;
-  std::vector<std::vector<int>> members = keepSupportedPlanes(planes, view1, view2, params, energy);
-  for (size_t k = 0; k < planes.size(); ++k) planes[k].inliers = std::move(members[k]);
+  auto assign = [&](std::vector<HomographyPlane>& ps) {
+    std::vector<std::vector<int>> members = keepSupportedPlanes(ps, view1, view2, params, energy);
+    for (size_t k = 0; k < ps.size(); ++k) ps[k].inliers = std::move(members[k]);
+  };
+  if (replaced) assign(planes);
+  // Pieces of one 3D plane, each at its own measured scale (a fixed threshold keeps the
+  // old behaviour): planes/epipolar_check.h.
+  if (energy.fixed_threshold_px > 0.0) return;
+  const PlaneCriterion criterion{[&](const HomographyPlane& p, const std::vector<int>& idx) {
+                                   std::vector<double> c;
+                                   const double width = energy.widthCost(p);
+                                   for (int i : idx)
+                                     c.push_back(energy.point(p, view1[i], view2[i], width));
+                                   return c;
+                                 },
+                                 [&](HomographyPlane& p, const std::vector<int>& idx) {
+                                   setPlaneNoise(p, view1, view2, idx, energy, params);
+                                 },
+                                 assign, energy.k2, energy.plane_cost};
+  mergeInducedPieces(planes, A, e, view1, view2, criterion);
 }
 
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose

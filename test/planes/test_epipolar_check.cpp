@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <random>
@@ -153,4 +154,166 @@ TEST(EpipolarCheck, InducedHomographyThroughPoints) {
   EXPECT_FALSE(fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, {a[0], a[1]}, {b[0], b[1]}));
   EXPECT_FALSE(fitInducedHomography(inducedBy(rig, kFront, 3.0), e2, {{0, 0}, {1, 1}, {2, 2}, {3, 3}},
                                     {{0, 0}, {1, 1}, {2, 2}, {3, 3}}));
+}
+
+namespace {
+// Points of the plane n.X = d seen at view-1 pixels drawn in a rectangle, both views with
+// pixel noise; `bend` adds a smooth error to view 2 (a lens model's residual: no
+// homography F induces follows it).
+void piece(const Rig& rig, const cv::Vec3d& n, double d, const cv::Rect2d& where, int count,
+           double noise_px, double bend_px, std::mt19937& rng, std::vector<cv::Point2d>& a,
+           std::vector<cv::Point2d>& b) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> g(0.0, noise_px);
+  for (int i = 0; i < count; ++i) {
+    const double s = u(rng);
+    const cv::Point2d x1(where.x + s * where.width, where.y + u(rng) * where.height);
+    const cv::Vec3d ray = rig.K.inv() * cv::Vec3d(x1.x, x1.y, 1.0);
+    const cv::Vec3d X = ray * (d / n.dot(ray));
+    const cv::Vec3d x2 = rig.K * (rig.R * X + rig.t);
+    a.emplace_back(x1.x + g(rng), x1.y + g(rng));
+    b.emplace_back(x2[0] / x2[2] + g(rng), x2[1] / x2[2] + bend_px * std::sin(CV_PI * s) + g(rng));
+  }
+}
+
+// The segmentation's criterion in miniature (planes/homography_voting.cpp): a Gaussian
+// cost in the plane's own scale (median-based, between 1 and 4 pair scales), truncated at
+// 8 scales; a label cost of 24 ln N; points to their cheapest plane.
+struct MiniCriterion {
+  const std::vector<cv::Point2d>& a;
+  const std::vector<cv::Point2d>& b;
+  double sigma;
+  double cost(const HomographyPlane& p, int i) const {
+    const double r = transferError(p.H, a[i], b[i]);
+    if (!(r < p.threshold_px)) return 64.0;
+    const double u = r / p.noise_px;
+    return std::min(u * u + 4.0 * std::log(p.noise_px / sigma), 64.0);
+  }
+  PlaneCriterion make() const {
+    PlaneCriterion c;
+    c.outlier_cost = 64.0;
+    c.label_cost = 24.0 * std::log(static_cast<double>(a.size()));
+    c.costs = [this](const HomographyPlane& p, const std::vector<int>& idx) {
+      std::vector<double> out;
+      for (int i : idx) out.push_back(cost(p, i));
+      return out;
+    };
+    c.measure = [this](HomographyPlane& p, const std::vector<int>& idx) {
+      std::vector<double> r;
+      for (int i : idx) r.push_back(transferError(p.H, a[i], b[i]));
+      std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+      p.noise_px = std::clamp(r[r.size() / 2] / 1.1774, sigma, 4.0 * sigma);  // Rayleigh median
+      p.threshold_px = 8.0 * p.noise_px;
+    };
+    c.assign = [this](std::vector<HomographyPlane>& planes) {
+      for (HomographyPlane& p : planes) p.inliers.clear();
+      for (size_t i = 0; i < a.size(); ++i) {
+        double best = 64.0;
+        HomographyPlane* to = nullptr;
+        for (HomographyPlane& p : planes) {
+          const double e = cost(p, static_cast<int>(i));
+          if (e < best) {
+            best = e;
+            to = &p;
+          }
+        }
+        if (to) to->inliers.push_back(static_cast<int>(i));
+      }
+    };
+    return c;
+  }
+};
+
+// The free homography through points [begin, end), with its scale.
+HomographyPlane freePlane(const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b,
+                          int begin, int end, const PlaneCriterion& c) {
+  HomographyPlane p;
+  for (int i = begin; i < end; ++i) p.inliers.push_back(i);
+  p.H = *fitHomography({a.begin() + begin, a.begin() + end}, {b.begin() + begin, b.begin() + end});
+  c.measure(p, p.inliers);
+  return p;
+}
+
+// F's epipole in view 2 and [e2]x F.
+void inducedBasis(const Rig& rig, cv::Matx33d& H1, cv::Vec3d& e2) {
+  e2 = rig.K * rig.t;
+  const cv::Matx33d ex(0, -e2[2], e2[1], e2[2], 0, -e2[0], -e2[1], e2[0], 0);
+  H1 = ex * rig.F();
+}
+}  // namespace
+
+TEST(EpipolarCheck, RobustInducedFitThroughPiecesOfDifferentNoise) {
+  Rig rig;
+  std::mt19937 rng(11);
+  const cv::Vec3d floor(0, -1, 0);
+  std::vector<cv::Point2d> a, b;
+  piece(rig, floor, -1.2, {100, 330, 440, 140}, 120, 0.2, 0.0, rng, a, b);
+  piece(rig, floor, -1.2, {60, 300, 240, 12}, 40, 1.0, 0.0, rng, a, b);
+  // A fifth of the second piece's matches gross outliers.
+  for (int i = 120; i < 128; ++i) b[i] += cv::Point2d(9.0, -7.0);
+  std::vector<double> scale(a.size(), 0.2), start(a.size(), 0.0);
+  for (size_t i = 120; i < a.size(); ++i) scale[i] = 1.0;
+  cv::Matx33d H1;
+  cv::Vec3d e2;
+  inducedBasis(rig, H1, e2);
+  const auto H = fitInducedRobust(H1, e2, a, b, scale, start);
+  ASSERT_TRUE(H);
+  const cv::Matx33d truth = inducedBy(rig, floor, -1.2);
+  for (const cv::Point2d& p : std::vector<cv::Point2d>{{60, 300}, {300, 400}, {540, 470}})
+    EXPECT_LT(transferError(*H, p, apply(truth, p)), 0.3) << p;
+  EXPECT_LT(skewSymmetryError(*H, rig.F()), 1e-9);
+  // Sizes that do not match: nothing.
+  EXPECT_FALSE(fitInducedRobust(H1, e2, a, b, {0.2}, start));
+}
+
+TEST(EpipolarCheck, MergesPiecesOfOnePlaneOnly) {
+  Rig rig;
+  const cv::Vec3d floor(0, -1, 0);
+  cv::Matx33d H1;
+  cv::Vec3d e2;
+  inducedBasis(rig, H1, e2);
+  // The floor, a strip of it at the image's edge where the lens model is poorer (its
+  // matches bent by up to 1 px), and a wall. Then the same strip 15 % farther than the
+  // floor (another plane): not merged.
+  for (const double strip_d : {-1.2, -1.2 * 1.15}) {
+    for (unsigned seed = 1; seed <= 10; ++seed) {
+      std::mt19937 rng(seed);
+      std::vector<cv::Point2d> a, b;
+      piece(rig, floor, -1.2, {150, 330, 440, 140}, 150, 0.2, 0.0, rng, a, b);
+      piece(rig, floor, strip_d, {20, 290, 240, 14}, 150, 0.15, 1.0, rng, a, b);
+      piece(rig, kFront, 3.0, {100, 40, 440, 160}, 100, 0.2, 0.0, rng, a, b);
+      const MiniCriterion mini{a, b, 0.2};
+      const PlaneCriterion c = mini.make();
+      std::vector<HomographyPlane> planes{freePlane(a, b, 0, 150, c), freePlane(a, b, 150, 300, c),
+                                          freePlane(a, b, 300, 400, c)};
+      const bool same_plane = strip_d == -1.2;
+      const int merges = mergeInducedPieces(planes, H1, e2, a, b, c);
+      EXPECT_EQ(merges, same_plane ? 1 : 0) << "seed " << seed << ", strip at " << strip_d;
+      ASSERT_EQ(planes.size(), same_plane ? 2u : 3u);
+      // The floor's plane holds its points (0-149) and the strip's (150-299, when on it),
+      // its homography the one the floor induces; the wall (300-399) is left alone.
+      const int floor_end = same_plane ? 300 : 150;
+      size_t floor_points = 0, wall_points = 0;
+      for (const HomographyPlane& p : planes) {
+        size_t on_floor = 0, on_wall = 0;
+        for (int i : p.inliers) {
+          if (i < floor_end) ++on_floor;
+          if (i >= 300) ++on_wall;
+        }
+        if (on_floor > on_wall) {
+          if (on_floor > floor_points) floor_points = on_floor;
+          if (same_plane) {
+            EXPECT_LT(skewSymmetryError(p.H, rig.F()), 1e-9);
+            EXPECT_LT(
+                transferError(p.H, {100, 297}, apply(inducedBy(rig, floor, -1.2), {100, 297})),
+                0.5);
+          }
+        } else {
+          wall_points = std::max(wall_points, on_wall);
+        }
+      }
+      EXPECT_GE(floor_points, same_plane ? 290u : 145u) << "seed " << seed;
+      EXPECT_GE(wall_points, 97u) << "seed " << seed;
+    }
+  }
 }

@@ -440,11 +440,11 @@ cv::Point2d apply(const cv::Matx33d& H, const cv::Point2d& p) {
 // SIFT matches undistorted by plane_pair --matches), seeds 1-20. A plane's homography is
 // plane-induced when the median over its points of the distance between its transfer and
 // the one the pose induces (n/d by least squares on H, as scripts/eval_euroc) is below
-// 1.5 px. The floor must be found and induced in every seed. Not every plane is: 7 of 49
-// here (8bea236: 11 of 55), of 16-74 points (a strip of floor tape, small clusters in the
-// bottom left corner where the lens model is poorest); an induced-only rule that brought
-// it to 3 of 47 lost a wall of the furnished room (docs/plane_core.md), so the bound
-// below guards today's figure.
+// 1.5 px. The floor must be found and induced in every seed. Not every plane is: 4 of 45
+// here (before the merge of pieces of one 3D plane, planes/epipolar_check.h: 7 of 49;
+// 8bea236: 11 of 55): two strips of floor tape (63 and 74 points) whose merge into the
+// floor falls short, and two clusters of 17-19 mismatched points in the bottom left
+// corner, where the lens model is poorest (docs/plane_core.md, EuRoC).
 TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
   std::ifstream txt(std::string(TEST_DATA_DIR) + "/euroc_1403715274212143104.txt");
   const Correspondences c = readCorrespondences(txt);
@@ -495,7 +495,7 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
     EXPECT_LT(floor_induced, 1.5) << "seed " << seed;  // 0.07-0.13 px
   }
   std::printf("not induced: %d planes over 20 seeds\n", not_induced);
-  EXPECT_LE(not_induced, 8);
+  EXPECT_LE(not_induced, 4);
 }
 
 // max_planes caps the planes found, whichever move adds them (the vote, the split move):

@@ -4,9 +4,12 @@
 // two planes at once, or of no plane, does not.
 #pragma once
 
+#include <functional>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
+
+#include "mono_plane_detection/planes/homography_voting.h"
 
 namespace mono_plane_detection {
 
@@ -49,5 +52,43 @@ std::optional<cv::Matx33d> fitInducedHomography(const cv::Matx33d& H1, const cv:
                                                 const std::vector<cv::Point2d>& from,
                                                 const std::vector<cv::Point2d>& to,
                                                 const std::vector<double>& weights = {});
+
+// fitInducedHomography through points whose noise scales differ (pieces of one plane in
+// different parts of the image, e.g. where the lens model is poorer): `rounds` re-weighted
+// fits, each point weighted by Cauchy(r / 2s) / s^2 (s its scale, r its transfer error:
+// residual_px in the first round, then the last fit's). Nothing when a fit fails or the
+// sizes differ.
+std::optional<cv::Matx33d> fitInducedRobust(const cv::Matx33d& H1, const cv::Vec3d& e2,
+                                            const std::vector<cv::Point2d>& from,
+                                            const std::vector<cv::Point2d>& to,
+                                            const std::vector<double>& scale_px,
+                                            const std::vector<double>& residual_px, int rounds = 3);
+
+// The terms of the segmentation's criterion (planes/homography_voting.cpp) that
+// mergeInducedPieces uses.
+struct PlaneCriterion {
+  // The points' costs under a plane at the plane's own scale (outlier_cost at most).
+  std::function<std::vector<double>(const HomographyPlane&, const std::vector<int>&)> costs;
+  // The plane's noise scale and threshold from its residuals over these points.
+  std::function<void(HomographyPlane&, const std::vector<int>&)> measure;
+  // Every point to its cheapest plane; planes that do not pay dropped.
+  std::function<void(std::vector<HomographyPlane>&)> assign;
+  double outlier_cost = 0.0;
+  double label_cost = 0.0;  // one plane's
+};
+
+// Pieces of one 3D plane merged, judged in the family of homographies F induces
+// (H1 + e2 v^T, H1 = [e2]x F): each plane's induced fit at its own measured scale; two
+// planes are merged when one induced homography through both, each piece's points costed
+// at that piece's scale, is cheaper than the two induced fits plus one label cost (every
+// point keeping its cheapest label). A piece's own scale holds what the camera model gets
+// wrong in its part of the image, so that a strip of tape on the floor, whose free
+// homography fits the lens model's error there (not plane-induced: 16-49 deg off), joins
+// the floor. Best merge first; the merged plane takes the induced homography and its
+// scale; points assigned again after each. Only planes whose induced fit pays for itself
+// take part. Returns the number of merges.
+int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& H1,
+                       const cv::Vec3d& e2, const std::vector<cv::Point2d>& view1,
+                       const std::vector<cv::Point2d>& view2, const PlaneCriterion& criterion);
 
 }  // namespace mono_plane_detection
