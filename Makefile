@@ -5,6 +5,7 @@
 #   make build   install deps and build the catkin workspace under build/ws
 #   make bench   the benchmark suite and end-to-end latency (figures, never pass/fail)
 #   make eval    the plane core vs sequential MAGSAC on the AdelaideRMF dev scenes (DATA=folder)
+#   make eval-euroc  the plane core on the EuRoC stereo pairs vs their known pose (EUROC=folder)
 #   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
 #   make helgrind  data-race check: the nodelets' rostests under helgrind
 #   make fuzz    libFuzzer targets of test/fuzz, FUZZ_SECONDS each (default 60)
@@ -21,7 +22,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build demo test bench eval sanitize helgrind fuzz clean
+.PHONY: deps link build demo test bench eval eval-euroc sanitize helgrind fuzz clean
 
 deps:
 	@scripts/install_deps.sh
@@ -96,6 +97,15 @@ bench: build
 
 eval: build
 	@source $(DEVEL) && rosrun mono_plane_detection eval_two_view $(DATA)
+
+# The plane core on the EuRoC stereo pairs, judged by their known relative pose
+# (EUROC=folder with cam0/ cam1/, SEEDS runs per pair); the script needs numpy.
+EUROC ?= $(REPO)/../shared/data/euroc_stereo
+SEEDS ?= 8
+eval-euroc: build
+	@scripts/install_deps.sh python3-numpy
+	@source $(DEVEL) && scripts/eval_euroc $(EUROC) --seeds $(SEEDS) \
+	  --plane-pair $(WS)/devel/lib/mono_plane_detection/plane_pair
 
 # Same sources, a second workspace with sanitizers (-O1 -g1: the sanitizers' usual level,
 # line numbers in reports, quicker to compile than -O2 -g). It builds and runs the gtests
