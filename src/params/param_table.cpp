@@ -297,6 +297,9 @@ const ParamTable<PoseParams>& poseParamTable() {
         {"floor_max_angle_deg", [](P& p) -> ParamField { return &p.floor.max_floor_angle_deg; },
          1, 89, "deg",
          "camera_height: the floor's normal is within this of the nominal down direction"},
+        {"bundle_window", field(&P::bundle_window), 0, 1000, "",
+         "keyframes refined together with their landmarks at each new keyframe (local bundle "
+         "adjustment, the oldest two fixed; 0: off)"},
     };
     appendNested(t, "two_view/", &P::two_view, twoViewParamTable());
     return t;
