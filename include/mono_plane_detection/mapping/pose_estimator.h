@@ -17,11 +17,11 @@
 #include <vector>
 
 #include "mono_plane_detection/geometry/pose.h"
-#include "mono_plane_detection/tracking/target_detector.h"
-#include "mono_plane_detection/tracking/track_frame.h"
 #include "mono_plane_detection/mapping/camera_height_scale.h"
 #include "mono_plane_detection/mapping/local_bundle_adjustment.h"
 #include "mono_plane_detection/mapping/two_view_init.h"
+#include "mono_plane_detection/tracking/target_detector.h"
+#include "mono_plane_detection/tracking/track_frame.h"
 
 namespace mono_plane_detection {
 
