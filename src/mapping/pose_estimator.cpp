@@ -1,6 +1,7 @@
 #include "mono_plane_detection/mapping/pose_estimator.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 
@@ -87,6 +88,7 @@ void PoseEstimator::reset() {
   floor_check_.reset();
   checking_pose_.reset();
   correction_ = Similarity();
+  keyframes_.clear();
 }
 
 std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const {
@@ -192,6 +194,8 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
     if (it != landmarks_.end()) it->second.last_seen = frame.stamp;
   }
   triangulate(frame, normalized, estimate->map_from_camera);
+  if (params_.bundle_window > 0 && estimate->source != PoseSource::kOdometry && !vision_only_)
+    bundleAdjust(frame, normalized, *estimate);
   forgetOldLandmarks();
   if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) {
     if (floor_check_ && floor_check_->unscaled) checking_pose_ = estimate;
@@ -215,6 +219,7 @@ void PoseEstimator::undoFloorStart(const std::string& why) {
   floor_views_.clear();
   floor_check_.reset();
   floor_reason_ = why;
+  keyframes_.clear();
 }
 
 bool PoseEstimator::checkFloor(PoseEstimate& estimate,
@@ -329,6 +334,7 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
     l.position = s.apply(l.position);
     l.anchor_pose = s.apply(l.anchor_pose);
   }
+  for (Keyframe& k : keyframes_) k.map_from_camera = s.apply(k.map_from_camera);
   estimate.map_from_camera = s.apply(estimate.map_from_camera);
   last_pose_ = estimate.map_from_camera;
   correction_ = s;
@@ -399,6 +405,7 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
             l.triangulated = false;
             l.anchor_pose = map_from_camera;
             l.anchor_normalized = normalized[index[k]];
+            l.anchor_stamp = frame.stamp;
             l.provisional = vision_only_;
           }
         }
@@ -510,18 +517,17 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
                                                   params_.two_view, corners, rotation);
   if (!init.ok) return {};
   first_view_.reset();
-  placeStartLandmarks(frame, ids, b, init.points, init.points_map, init.parallax_deg,
-                      init.map_from_second);
+  placeStartLandmarks(frame, ids, a, b, init.points, init.points_map, init.parallax_deg,
+                      init.map_from_first, init.map_from_second);
   return PoseEstimate{init.map_from_second, PoseSource::kTarget,
                       static_cast<int>(init.points.size()), 0};
 }
 
-void PoseEstimator::placeStartLandmarks(const TrackFrame& frame,
-                                        const std::vector<std::uint64_t>& ids,
-                                        const std::vector<cv::Point2d>& second,
-                                        const std::vector<int>& points,
-                                        const std::vector<cv::Vec3d>& points_map,
-                                        double parallax_deg, const Pose& map_from_second) {
+void PoseEstimator::placeStartLandmarks(
+    const TrackFrame& frame, const std::vector<std::uint64_t>& ids,
+    const std::vector<cv::Point2d>& first, const std::vector<cv::Point2d>& second,
+    const std::vector<int>& points, const std::vector<cv::Vec3d>& points_map, double parallax_deg,
+    const Pose& map_from_first, const Pose& map_from_second) {
   for (size_t k = 0; k < points.size(); ++k) {
     Landmark& l = landmarks_[ids[points[k]]];
     l.triangulated = true;
@@ -529,6 +535,7 @@ void PoseEstimator::placeStartLandmarks(const TrackFrame& frame,
     l.parallax_deg = parallax_deg;
     l.anchor_pose = map_from_second;
     l.anchor_normalized = second[points[k]];
+    l.anchor_stamp = frame.stamp;
     l.last_seen = frame.stamp;
   }
   initialised_ = true;
@@ -537,6 +544,13 @@ void PoseEstimator::placeStartLandmarks(const TrackFrame& frame,
   cv::undistortPoints(frame.pixels, normalized, K_, distortion_);
   triangulate(frame, normalized, map_from_second);  // anchors for the other tracks
   forgetOldLandmarks();
+  // The start's two views are the first keyframes (the bundle adjustment's fixed pair:
+  // they hold its scale).
+  keyframes_.clear();
+  if (params_.bundle_window > 0) {
+    keyframes_.push_back(Keyframe{-1, map_from_first, ids, first});
+    keyframes_.push_back(Keyframe{frame.stamp, map_from_second, frame.ids, normalized});
+  }
 }
 
 std::optional<PoseEstimate> PoseEstimator::startFromFloor(
@@ -687,7 +701,8 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
   }
   metric_ = MetricSource::kCameraHeight;
   floor_reason_.clear();
-  placeStartLandmarks(frame, ids, b, points, points_map, floor->parallax_deg, map_from_second);
+  placeStartLandmarks(frame, ids, a, b, points, points_map, floor->parallax_deg, map_from_first,
+                      map_from_second);
   floor_views_.clear();
   return PoseEstimate{map_from_second, PoseSource::kLandmarks, static_cast<int>(points.size()), 0};
 }
@@ -711,6 +726,7 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
     if (is_new) {
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[i];
+      l.anchor_stamp = frame.stamp;
       l.last_seen = frame.stamp;
       l.provisional = vision_only_;
       continue;
@@ -748,10 +764,127 @@ void PoseEstimator::restartProvisional(const TrackFrame& frame,
       l = Landmark();
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[seen->second];
+      l.anchor_stamp = frame.stamp;
       l.last_seen = frame.stamp;
       ++it;
     }
   }
+}
+
+void PoseEstimator::bundleAdjust(const TrackFrame& frame,
+                                 const std::vector<cv::Point2d>& normalized,
+                                 PoseEstimate& estimate) {
+  // A new keyframe once the tracks shared with the last one have moved 2 % of the focal
+  // length (median; about 10 px), or half of that keyframe's tracks are gone: a still
+  // camera adds none, and the window spans the motion, not the frame rate.
+  if (!keyframes_.empty()) {
+    const Keyframe& last = keyframes_.back();
+    std::unordered_map<std::uint64_t, size_t> in_last;
+    for (size_t i = 0; i < last.ids.size(); ++i) in_last.emplace(last.ids[i], i);
+    std::vector<double> moved;
+    for (size_t i = 0; i < frame.ids.size(); ++i) {
+      const auto it = in_last.find(frame.ids[i]);
+      if (it != in_last.end())
+        moved.push_back(cv::norm(normalized[i] - last.normalized[it->second]));
+    }
+    constexpr double kKeyframeMotion = 0.02;
+    if (moved.size() * 2 >= last.ids.size() && median(moved) < kKeyframeMotion) return;
+  }
+  keyframes_.push_back(Keyframe{frame.stamp, estimate.map_from_camera, frame.ids, normalized});
+  while (keyframes_.size() > static_cast<size_t>(std::max(params_.bundle_window, 3)))
+    keyframes_.pop_front();
+  if (keyframes_.size() < 3) return;
+  const auto started = std::chrono::steady_clock::now();
+
+  // Views: the keyframes (the oldest two fixed: they hold position, orientation and
+  // scale), then the anchors of their landmarks first seen elsewhere (fixed: the map
+  // before the window).
+  BundleProblem problem;
+  std::unordered_map<double, int> keyframe_of_stamp;
+  for (size_t k = 0; k < keyframes_.size(); ++k) {
+    problem.views.push_back({keyframes_[k].map_from_camera, k < 2});
+    keyframe_of_stamp.emplace(keyframes_[k].stamp, static_cast<int>(k));
+  }
+  std::unordered_map<std::uint64_t, int> point_of;
+  std::vector<std::uint64_t> point_ids;
+  for (size_t k = 0; k < keyframes_.size(); ++k) {
+    const Keyframe& kf = keyframes_[k];
+    for (size_t i = 0; i < kf.ids.size(); ++i) {
+      const auto it = landmarks_.find(kf.ids[i]);
+      if (it == landmarks_.end() || it->second.provisional ||
+          !(it->second.triangulated || it->second.fixed))
+        continue;
+      auto [at, is_new] = point_of.try_emplace(kf.ids[i], static_cast<int>(problem.points.size()));
+      if (is_new) {
+        problem.points.push_back({it->second.position, it->second.fixed});
+        point_ids.push_back(kf.ids[i]);
+      }
+      problem.observations.push_back({static_cast<int>(k), at->second, kf.normalized[i]});
+    }
+  }
+  const size_t keyframe_observations = problem.observations.size();
+  for (size_t j = 0; j < point_ids.size(); ++j) {
+    const Landmark& l = landmarks_.at(point_ids[j]);
+    if (l.fixed || keyframe_of_stamp.count(l.anchor_stamp)) continue;
+    problem.views.push_back({l.anchor_pose, true});
+    problem.observations.push_back(
+        {static_cast<int>(problem.views.size()) - 1, static_cast<int>(j), l.anchor_normalized});
+  }
+  // A point seen once has no depth to refine: held.
+  std::vector<int> seen(problem.points.size(), 0);
+  for (const BundleObservation& o : problem.observations) ++seen[o.point];
+  for (size_t j = 0; j < seen.size(); ++j)
+    if (seen[j] < 2) problem.points[j].fixed = true;
+
+  BundleOptions options;
+  options.focal_px = K_(0, 0);
+  const BundleResult result = adjustBundle(problem, options);
+  if (result.ok) {
+    for (size_t k = 2; k < keyframes_.size(); ++k)
+      keyframes_[k].map_from_camera = problem.views[k].map_from_camera;
+    for (size_t j = 0; j < point_ids.size(); ++j) {
+      Landmark& l = landmarks_.at(point_ids[j]);
+      if (!l.fixed) l.position = problem.points[j].position;
+      const auto kf = keyframe_of_stamp.find(l.anchor_stamp);
+      if (kf != keyframe_of_stamp.end()) l.anchor_pose = keyframes_[kf->second].map_from_camera;
+    }
+    // Observations the adjusted map disagrees with (beyond the Huber threshold: they had
+    // little weight) no longer count: an older keyframe's is dropped from it; this
+    // image's, beyond the PnP inlier threshold too, starts its landmark again (as a PnP
+    // outlier).
+    const int newest = static_cast<int>(keyframes_.size()) - 1;
+    std::vector<std::vector<std::uint64_t>> dropped(keyframes_.size());
+    for (size_t o = 0; o < keyframe_observations; ++o) {
+      if (!result.outlier[o]) continue;
+      const BundleObservation& b = problem.observations[o];
+      Landmark& l = landmarks_.at(point_ids[b.point]);
+      if (l.fixed) continue;
+      if (b.view == newest) {
+        if (!(result.residual_px[o] > params_.max_reprojection_px)) continue;
+        l.triangulated = false;
+        l.anchor_pose = problem.views[newest].map_from_camera;
+        l.anchor_normalized = b.normalized;
+        l.anchor_stamp = frame.stamp;
+      } else {
+        dropped[b.view].push_back(point_ids[b.point]);
+      }
+    }
+    for (size_t k = 0; k < keyframes_.size(); ++k) {
+      if (dropped[k].empty()) continue;
+      Keyframe& kf = keyframes_[k];
+      for (size_t i = kf.ids.size(); i-- > 0;)
+        if (std::find(dropped[k].begin(), dropped[k].end(), kf.ids[i]) != dropped[k].end()) {
+          kf.ids.erase(kf.ids.begin() + static_cast<long>(i));
+          kf.normalized.erase(kf.normalized.begin() + static_cast<long>(i));
+        }
+    }
+    estimate.map_from_camera = keyframes_.back().map_from_camera;
+    last_pose_ = estimate.map_from_camera;
+  }
+  if (bundle_times_ms_.size() >= 1000) bundle_times_ms_.erase(bundle_times_ms_.begin());
+  bundle_times_ms_.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+          .count());
 }
 
 void PoseEstimator::forgetOldLandmarks() {

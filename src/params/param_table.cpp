@@ -294,9 +294,12 @@ const ParamTable<PoseParams>& poseParamTable() {
          "m", "camera_height: the optical centre's height above the floor (0: unknown)"},
         {"camera_pitch_deg", [](P& p) -> ParamField { return &p.floor.pitch_down_deg; }, -90, 90,
          "deg", "camera_height: nominal camera tilt below the horizon, to tell the floor"},
-        {"floor_max_angle_deg", [](P& p) -> ParamField { return &p.floor.max_floor_angle_deg; },
-         1, 89, "deg",
+        {"floor_max_angle_deg", [](P& p) -> ParamField { return &p.floor.max_floor_angle_deg; }, 1,
+         89, "deg",
          "camera_height: the floor's normal is within this of the nominal down direction"},
+        {"bundle_window", field(&P::bundle_window), 0, 1000, "",
+         "keyframes refined together with their landmarks at each new keyframe (local bundle "
+         "adjustment, the oldest two fixed; 0: off)"},
     };
     appendNested(t, "two_view/", &P::two_view, twoViewParamTable());
     return t;

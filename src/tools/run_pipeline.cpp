@@ -234,6 +234,13 @@ int main(int argc, char** argv) {
         "(start %.1f), landmarks %zu, map planes %zu\n",
         loop + 1, track_ms / frames, plane_ms / frames, rss, start_rss,
         pipeline.poseEstimator()->landmarks().size(), pipeline.map().planes().size());
+    if (std::vector<double> t = pipeline.poseEstimator()->bundleTimesMs(); !t.empty()) {
+      std::sort(t.begin(), t.end());
+      double sum = 0;
+      for (double v : t) sum += v;
+      std::printf("bundle adjustment: %zu keyframes, %.2f ms mean, %.2f ms p95, %.2f ms max\n",
+                  t.size(), sum / static_cast<double>(t.size()), t[t.size() * 95 / 100], t.back());
+    }
     if (loop + 1 < loops) continue;
     // camera_height's map has its own origin and heading: the rigid motion that best
     // aligns the camera paths (as the rostest judges it), its up judged on its own.

@@ -114,11 +114,12 @@ bool found(const RoomRun& run, const std::string& name) {
 
 }  // namespace
 
-// Figures on this commit (normal deg / distance m), wheeled: front wall 0.78 / 0.006, floor
-// 0.74 / 0.003, shelf front 1.51 / 0.010, left wall 1.96 / 0.096, camera 1.1 % of the path
+// Figures on this commit (normal deg / distance m), wheeled: front wall 0.95 / 0.000, floor
+// 0.41 / 0.002, shelf front 1.06 / 0.010, left wall 1.30 / 0.021, camera 0.5 % of the path
 // (2.0 % before the start averaged its orientation over the images, 1.4 % before the
-// sheet was re-detected around its tracks); humanoid: front wall 0.50 / 0.000, shelf front
-// 0.39 / 0.004, left wall 0.28 / 0.022, floor 0.23 / 0.022, camera 0.6 %. Missed, and not
+// sheet was re-detected around its tracks, 1.1 % before the local bundle adjustment:
+// left wall 1.96 / 0.096); humanoid: front wall 0.06 / 0.003, shelf front 0.72 / 0.009,
+// left wall 0.73 / 0.018, floor 0.14 / 0.019, camera 0.4 % (0.6 % before). Missed, and not
 // mappable here (docs/mapping.md): the
 // sideboard front (wheeled: in view only before the metric start) and the back wall
 // (humanoid: plain paint, no corner on it).
@@ -131,13 +132,16 @@ TEST(FurnishedRoom, WheeledPath) {
   for (const std::string name : {"front_wall", "floor", "shelf_+x", "left_wall"})
     EXPECT_TRUE(found(run, name)) << name;
   EXPECT_LT(run.eval.worst_normal_error_deg, 2.0);  // the issue's bound
-  EXPECT_LT(run.eval.worst_distance_error_m, 0.10);
+  // 0.096 m (left wall) before the local bundle adjustment, 0.021 m since (0.015 m in
+  // run_pipeline's profiles, noise seed 2).
+  EXPECT_LT(run.eval.worst_distance_error_m, 0.05);
   EXPECT_GE(run.posed, 250);
   // The target seen face-on from 2 m tilts the map (1.9 deg with the corners averaged,
   // 2.0 % of the path; 1.4 % with the orientations averaged, 1.1 % with the corners
-  // re-detected: docs/mapping.md "The wheeled start's tilt"); the worst is now at the end
-  // of the path. Runs move by 0.3 % with small corner changes.
-  EXPECT_LT(run.worst_camera_m, 0.015 * run.travelled_m);
+  // re-detected: docs/mapping.md "The wheeled start's tilt"); the worst was then at the
+  // end of the path: the poses' drift, 0.5 % with the local bundle adjustment (0.4 % in
+  // run_pipeline's profiles; the bare room's noise seeds 0-3 0.3-0.5 %). Issue 18's 1 %.
+  EXPECT_LT(run.worst_camera_m, 0.01 * run.travelled_m);
 }
 
 TEST(FurnishedRoom, HumanoidPath) {

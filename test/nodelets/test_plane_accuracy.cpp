@@ -11,9 +11,9 @@
 // camera_height is held to the bounds: normal < 3 deg, distance < 5 % of the
 // plane's distance from the first camera, camera < 5 % of the path (held on every
 // image-noise seed that starts); its map up < 4 deg. The humanoid's camera_height map
-// (an up-to-scale start whose floor is mapped only after the turn) misses the issue's
-// normal bound (left wall 3.45 deg): held to 4 deg, its distances to the 5 %
-// (docs/mapping.md).
+// (an up-to-scale start whose floor is mapped only after the turn) meets the issue's
+// normal bound since the local bundle adjustment (worst 2.66 deg on this seed;
+// docs/mapping.md).
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -211,11 +211,14 @@ TEST(PlaneAccuracy, RenderedSequence) {
     // from the floor landmarks' anchors when the drifted path finds no floor): camera
     // 0.1 %, normals 2.0 (front wall), 3.45 (left wall), 2.05 deg (floor), distances 3.4 %
     // (front wall), 2.6 %, 2.4 %; image-noise seeds 1-4 within 3.23 deg and 3.1 %
-    // (run_pipeline). The 3 deg is NOT met on the humanoid (the
-    // up-to-scale map drifts between the left wall, mapped before the turn, and the
-    // floor after it): held to 4 deg so that a worse start fails; distances to 5 %.
+    // (run_pipeline). The up-to-scale map drifted between the left wall, mapped before
+    // the turn, and the floor after it: the 3 deg was missed (held to 4 deg).
+    // With the local bundle adjustment (pose/bundle_window): wheeled left wall 0.79 deg,
+    // 0.9 %; humanoid normals 0.78 (front wall), 1.85 (left wall), 2.66 deg (floor),
+    // distances 0.5 / 0.4 / 0.4 %; image-noise seeds 1-4 within 1.61 deg and 2.4 %
+    // (run_pipeline). Seed 0's floor moves by about a degree with small solver changes.
     EXPECT_LT(worst, 0.05 * truth.travelled_m);
-    EXPECT_LT(e.worst_normal_error_deg, humanoid_height ? 4.0 : 3.0);
+    EXPECT_LT(e.worst_normal_error_deg, 3.0);
     for (size_t i = 0; i < mapped.size(); ++i)
       for (const TruthPlane& t : truth_planes)
         if (t.id == e.matches[i].truth_id) {

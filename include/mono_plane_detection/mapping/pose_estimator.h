@@ -17,10 +17,11 @@
 #include <vector>
 
 #include "mono_plane_detection/geometry/pose.h"
+#include "mono_plane_detection/mapping/camera_height_scale.h"
+#include "mono_plane_detection/mapping/local_bundle_adjustment.h"
+#include "mono_plane_detection/mapping/two_view_init.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 #include "mono_plane_detection/tracking/track_frame.h"
-#include "mono_plane_detection/mapping/camera_height_scale.h"
-#include "mono_plane_detection/mapping/two_view_init.h"
 
 namespace mono_plane_detection {
 
@@ -38,6 +39,11 @@ struct PoseParams {
   // them that is available). Once one has started the map, the others are ignored.
   std::string metric_source = "target";
   FloorParams floor;  // camera_height (camera_height_scale.h)
+  // Keyframes of the local bundle adjustment run at each new keyframe (the oldest two
+  // held fixed); 0: none (local_bundle_adjustment.h). Measured (docs/mapping.md): the
+  // humanoid camera_height map's worst normal 3.45 -> 2.66 deg (noise seed 0); 6
+  // keyframes missed a floor, 20 took 3-5 times as long.
+  int bundle_window = 10;
 };
 
 // The source that started the metric map.
@@ -53,6 +59,7 @@ struct Landmark {
   bool fixed = false;             // a target corner: position known exactly
   cv::Vec3d position;             // map frame, m (when triangulated or fixed)
   Pose anchor_pose;               // map_from_camera at the anchor observation
+  double anchor_stamp = -1;       // that image's stamp (a keyframe's, when it became one)
   cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
   double parallax_deg = 0;        // between the two rays of the triangulation
   double last_seen = 0;           // stamp, s
@@ -114,6 +121,8 @@ class PoseEstimator {
   // After a pause (tracking loss) the last pose is no guide to the next.
   void forgetLastPose() { last_pose_.reset(); }
   void reset();
+  // The local bundle adjustment's time per run, ms (the last 1000 keyframes it ran at).
+  const std::vector<double>& bundleTimesMs() const { return bundle_times_ms_; }
 
  private:
   std::optional<PoseEstimate> visualPose(const TrackFrame& frame,
@@ -128,10 +137,17 @@ class PoseEstimator {
                                              const std::vector<cv::Point2d>& normalized,
                                              bool& unscaled);
   // Landmarks of a two-view start; the second view is this frame.
+  // The first view (ids, first) and this frame become the first keyframes.
   void placeStartLandmarks(const TrackFrame& frame, const std::vector<std::uint64_t>& ids,
+                           const std::vector<cv::Point2d>& first,
                            const std::vector<cv::Point2d>& second, const std::vector<int>& points,
                            const std::vector<cv::Vec3d>& points_map, double parallax_deg,
-                           const Pose& map_from_second);
+                           const Pose& map_from_first, const Pose& map_from_second);
+  // Adds this frame as a keyframe when its tracks have moved since the last one, and
+  // then adjusts the window (local_bundle_adjustment.h): the keyframes' poses, their
+  // landmarks and the estimate's pose.
+  void bundleAdjust(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                    PoseEstimate& estimate);
   bool allows(MetricSource source) const;
   void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                           const Pose& map_from_camera);
@@ -195,6 +211,14 @@ class PoseEstimator {
   std::optional<FloorCheck> floor_check_;
   std::optional<PoseEstimate> checking_pose_;
   Similarity correction_;
+  struct Keyframe {
+    double stamp = -1;
+    Pose map_from_camera;
+    std::vector<std::uint64_t> ids;
+    std::vector<cv::Point2d> normalized;
+  };
+  std::deque<Keyframe> keyframes_;  // the newest bundle_window
+  std::vector<double> bundle_times_ms_;
 };
 
 }  // namespace mono_plane_detection

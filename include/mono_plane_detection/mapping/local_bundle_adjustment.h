@@ -1,0 +1,66 @@
+// Local bundle adjustment (beyond the paper; as PTAM's and ORB-SLAM's local mapping):
+// the camera poses of the last few keyframes and the landmarks they see are refined
+// together by minimising the reprojection error, so that the drift of one frame-to-frame
+// pose (PnP on landmarks triangulated from two views) does not pass into every later
+// landmark. Levenberg-Marquardt on the normal equations with the points eliminated
+// (Schur complement onto the poses: a dense 6n x 6n system, n the free poses), Huber
+// weights in units of the observations' own noise (measured from the residuals). The
+// views marked fixed (the oldest keyframes, the views landmarks were first seen from)
+// fix the gauge: position, orientation and, with two of them apart, the scale. ROS-free.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mono_plane_detection/geometry/pose.h"
+
+namespace mono_plane_detection {
+
+struct BundleOptions {
+  int max_iterations = 10;     // Levenberg-Marquardt steps
+  double huber_sigmas = 2.45;  // Huber threshold, in sigmas of the residual (chi2 95 %, 2 dof)
+  double min_sigma_px = 0.1;   // the residuals' noise is taken as at least this
+  double focal_px = 500;       // residuals in pixels: normalised error times the focal length
+};
+
+struct BundleView {
+  Pose map_from_camera;
+  bool fixed = false;
+};
+
+struct BundlePoint {
+  cv::Vec3d position;  // map frame
+  bool fixed = false;
+};
+
+struct BundleObservation {
+  int view = 0;
+  int point = 0;
+  cv::Point2d normalized;  // undistorted normalised image coordinates
+};
+
+struct BundleProblem {
+  std::vector<BundleView> views;
+  std::vector<BundlePoint> points;
+  std::vector<BundleObservation> observations;
+};
+
+struct BundleResult {
+  bool ok = false;
+  std::string reason;         // why not, when !ok
+  int iterations = 0;         // steps taken (accepted or not)
+  double sigma_px = 0;        // the residuals' noise, measured after the first round
+  double initial_rms_px = 0;  // reprojection rms of the inliers before and after
+  double final_rms_px = 0;
+  // Per observation: its residual after the adjustment is beyond the Huber threshold.
+  std::vector<bool> outlier;
+  // Per observation: its residual after the adjustment, px (infinite: behind the camera).
+  std::vector<double> residual_px;
+};
+
+// Refines the free views and points of `problem` in place. Every free point needs two
+// observations and every free view some; a point behind a camera keeps its observation
+// out of that step. Nothing is changed when the cost does not fall.
+BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options);
+
+}  // namespace mono_plane_detection
