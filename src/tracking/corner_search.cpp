@@ -108,7 +108,8 @@ double noiseLevel(const cv::Mat& image, double cell_px, NoiseLevelBuffers* buffe
     b.column_cell[x] = std::min(cols - 1, static_cast<int>(x / cell_px)) * bins;
   for (int y = 0; y < image.rows; ++y) {
     const short* row = b.response.ptr<short>(y);
-    int* cell_row = b.histograms.data() + std::min(rows - 1, static_cast<int>(y / cell_px)) * cols * bins;
+    int* cell_row =
+        b.histograms.data() + std::min(rows - 1, static_cast<int>(y / cell_px)) * cols * bins;
     for (int x = 0; x < image.cols; ++x)
       ++cell_row[b.column_cell[x] + std::min(bins - 1, std::abs(static_cast<int>(row[x])))];
   }
@@ -136,8 +137,8 @@ double noiseCornerFloor(const cv::Mat& image, int level, int block_size, double 
 }
 
 void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
-                         double noise_floor, double cell_px, double min_distance,
-                         int block_size, size_t max_corners, ShiTomasiBuffers& buffers,
+                         double noise_floor, double cell_px, double min_distance, int block_size,
+                         size_t max_corners, ShiTomasiBuffers& buffers,
                          std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed_cells) {
   corners.clear();
   relaxed_cells.clear();
@@ -170,8 +171,8 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
     }
     relaxed_cells.resize(bar.size());
     for (size_t c = 0; c < bar.size(); ++c) {
-      const float own = std::max(static_cast<float>(noise_floor),
-                                 static_cast<float>(quality_level) * bar[c]);
+      const float own =
+          std::max(static_cast<float>(noise_floor), static_cast<float>(quality_level) * bar[c]);
       bar[c] = std::min(global_bar, own);
       relaxed_cells[c] = bar[c] < global_bar;
     }
@@ -337,9 +338,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   relaxed.top = on_level.y;
   const double noise_floor =
       spread && params.corner_noise_margin > 0
-          ? params.corner_noise_margin *
-                noiseCornerFloor(searched, level, params.block_size, relaxed.cell_px,
-                                 &buffers.noise)
+          ? params.corner_noise_margin * noiseCornerFloor(searched, level, params.block_size,
+                                                          relaxed.cell_px, &buffers.noise)
           : 0.0;
   // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
   // the scores at the band's edge are those of the whole image.)
@@ -347,7 +347,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                       noise_floor, relaxed.cell_px, min_distance, params.block_size,
                       noise_floor > 0 ? 0 : static_cast<size_t>(pool), buffers.shi_tomasi, corners,
                       relaxed.relaxed);
-  relaxed.cols = static_cast<int>(std::ceil(searched.cols / relaxed.cell_px));
+  relaxed.cols =
+      relaxed.relaxed.empty() ? 0 : static_cast<int>(std::ceil(searched.cols / relaxed.cell_px));
   if (corners.empty()) return corners;
   const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
   for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
