@@ -89,6 +89,10 @@ const ParamTable<TrackerParams>& trackerParamTable() {
       {"spread_grid_columns", field(&P::spread_grid_columns), 0, 1000, "",
        "new corners go first to the cells with the fewest points, on a grid of this many "
        "columns of square cells (0: strongest in the image first, the paper)"},
+      {"corner_noise_margin", field(&P::corner_noise_margin), 0, 1000, "",
+       "each grid cell also takes corners above quality_level of its own strongest, never "
+       "under this many times the strongest response of the image's noise (0: the image's "
+       "bar alone, the paper)"},
       {"pyramid_levels", field(&P::pyramid_levels), 1, 10, "",
        "LK pyramid levels including full resolution (paper: 5)"},
       {"window_size_px", field(&P::window_size_px), 3, 51, "px",

@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   paper.forward_backward_check = paper.reanchor_on_search = false;
   paper.mask_existing = paper.reidentify = false;
   paper.spread_grid_columns = 0;
+  paper.corner_noise_margin = 0;
   printRow("paper (3x3 window, all off)", run(paper, walk, texture, vga, frames));
   TrackerParams paper_fb = paper;
   paper_fb.forward_backward_check = true;
@@ -160,5 +161,8 @@ int main(int argc, char** argv) {
   p = all;
   p.spread_grid_columns = 0;
   printRow("without spreading over cells", run(p, walk, texture, vga, frames));
+  p = all;
+  p.corner_noise_margin = 0;
+  printRow("without the cells' own quality bar", run(p, walk, texture, vga, frames));
   return 0;
 }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 
 #include "mono_plane_detection/tracking/feature_tracker.h"
@@ -44,6 +46,198 @@ int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>&
   }
   corners.resize(kept);
   return static_cast<int>(before - kept);
+}
+
+namespace {
+
+// The grouped median of |r| for integer values held in `histogram` (bin v: |r| == v),
+// interpolated within its bin, so that a low noise level is not rounded to a grey level.
+double groupedMedian(const int* histogram, int bins, int total) {
+  const double half = 0.5 * total;
+  int below = 0;
+  for (int v = 0; v < bins; ++v) {
+    if (below + histogram[v] >= half && histogram[v] > 0)
+      return v - 0.5 + (half - below) / histogram[v];
+    below += histogram[v];
+  }
+  return bins;
+}
+
+// The strongest Shi-Tomasi response (cornerMinEigenVal, block_size, Sobel 3) of white
+// noise shrunk `level` times by pyrDown, per squared unit of noiseLevel: the same
+// estimator on the same processing, so that the ratio holds for any noise level. Measured
+// once per (level, block size) on a fixed 512 x 512 noise image (a 640 x 480 image's
+// pixels at full resolution).
+double noiseResponsePerLevel2(int level, int block_size) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, double> measured;
+  const std::lock_guard<std::mutex> lock(mutex);
+  const auto key = std::make_pair(level, block_size);
+  const auto it = measured.find(key);
+  if (it != measured.end()) return it->second;
+  cv::Mat noise(512, 512, CV_8UC1);
+  cv::RNG rng(12345);
+  rng.fill(noise, cv::RNG::NORMAL, 128, 8);  // 8 grey levels: quantization plays no part
+  for (int l = 0; l < level; ++l) cv::pyrDown(noise, noise);
+  cv::Mat eig;
+  cv::cornerMinEigenVal(noise, eig, block_size, 3);
+  double strongest = 0;
+  cv::minMaxLoc(eig, nullptr, &strongest);
+  const double level_of_noise = noiseLevel(noise, 0, nullptr);
+  return measured[key] = strongest / (level_of_noise * level_of_noise);
+}
+
+}  // namespace
+
+double noiseLevel(const cv::Mat& image, double cell_px, NoiseLevelBuffers* buffers) {
+  CV_Assert(image.type() == CV_8UC1);
+  if (image.empty()) return 0;
+  NoiseLevelBuffers own;
+  NoiseLevelBuffers& b = buffers != nullptr ? *buffers : own;
+  static const cv::Matx33f kernel(1, -2, 1, -2, 4, -2, 1, -2, 1);
+  cv::filter2D(image, b.response, CV_16S, kernel);
+  if (cell_px <= 0) cell_px = std::max(image.cols, image.rows);
+  const int cols = std::max(1, static_cast<int>(std::ceil(image.cols / cell_px)));
+  const int rows = std::max(1, static_cast<int>(std::ceil(image.rows / cell_px)));
+  // |r| above the cap is texture, not noise (a median under it is exact: noise of up to
+  // 60 grey levels).
+  const int bins = 257;
+  b.histograms.assign(static_cast<size_t>(cols * rows * bins), 0);
+  b.column_cell.resize(image.cols);
+  for (int x = 0; x < image.cols; ++x)
+    b.column_cell[x] = std::min(cols - 1, static_cast<int>(x / cell_px)) * bins;
+  for (int y = 0; y < image.rows; ++y) {
+    const short* row = b.response.ptr<short>(y);
+    int* cell_row =
+        b.histograms.data() + std::min(rows - 1, static_cast<int>(y / cell_px)) * cols * bins;
+    for (int x = 0; x < image.cols; ++x)
+      ++cell_row[b.column_cell[x] + std::min(bins - 1, std::abs(static_cast<int>(row[x])))];
+  }
+  // The flattest cell shows the noise alone (its median ignores a few edges or corners);
+  // cells where most responses are exactly 0 hold no noise to measure (clipped, or drawn
+  // without noise) and are left out.
+  double lowest = -1;
+  for (int c = 0; c < cols * rows; ++c) {
+    const int* h = b.histograms.data() + c * bins;
+    int total = 0;
+    for (int v = 0; v < bins; ++v) total += h[v];
+    if (total == 0 || 2 * h[0] >= total) continue;
+    const double median = groupedMedian(h, bins, total);
+    if (lowest < 0 || median < lowest) lowest = median;
+  }
+  return std::max(0.0, lowest);
+}
+
+double noiseCornerFloor(const cv::Mat& image, int level, int block_size, double cell_px,
+                        NoiseLevelBuffers* buffers) {
+  // At least the response of half a grey level (below it the image holds no noise to
+  // measure: the floor of 8-bit quantization).
+  const double noise = std::max(0.5, noiseLevel(image, cell_px, buffers));
+  return noiseResponsePerLevel2(level, block_size) * noise * noise;
+}
+
+void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
+                         double noise_floor, double cell_px, double min_distance, int block_size,
+                         size_t max_corners, ShiTomasiBuffers& buffers,
+                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed_cells) {
+  corners.clear();
+  relaxed_cells.clear();
+  if (image.empty()) return;
+  cv::Mat& eig = buffers.eig;
+  cv::cornerMinEigenVal(image, eig, block_size, 3);
+  double strongest = 0;
+  cv::minMaxLoc(eig, nullptr, &strongest, nullptr, nullptr, mask);
+  const float global_bar = static_cast<float>(quality_level * strongest);
+  // Per cell: the bar is the lower of the image's and the cell's own (quality_level of its
+  // strongest response, masked or not, so that it does not change with the live points),
+  // never under the noise floor. No floor: the image's bar alone (the paper).
+  const bool per_cell = noise_floor > 0 && cell_px > 0;
+  const int cols = per_cell ? std::max(1, static_cast<int>(std::ceil(image.cols / cell_px))) : 1;
+  const int rows = per_cell ? std::max(1, static_cast<int>(std::ceil(image.rows / cell_px))) : 1;
+  std::vector<float>& bar = buffers.bar;
+  bar.assign(static_cast<size_t>(cols * rows), 0.f);
+  std::vector<int>& column_cell = buffers.column_cell;
+  column_cell.resize(image.cols);
+  for (int x = 0; x < image.cols; ++x)
+    column_cell[x] = per_cell ? std::min(cols - 1, static_cast<int>(x / cell_px)) : 0;
+  auto rowCell = [&](int y) {
+    return per_cell ? std::min(rows - 1, static_cast<int>(y / cell_px)) * cols : 0;
+  };
+  if (per_cell) {
+    for (int y = 0; y < image.rows; ++y) {
+      const float* e = eig.ptr<float>(y);
+      float* b = bar.data() + rowCell(y);
+      for (int x = 0; x < image.cols; ++x) b[column_cell[x]] = std::max(b[column_cell[x]], e[x]);
+    }
+    relaxed_cells.resize(bar.size());
+    for (size_t c = 0; c < bar.size(); ++c) {
+      const float own =
+          std::max(static_cast<float>(noise_floor), static_cast<float>(quality_level) * bar[c]);
+      bar[c] = std::min(global_bar, own);
+      relaxed_cells[c] = bar[c] < global_bar;
+    }
+  } else {
+    bar[0] = global_bar;
+  }
+  // As goodFeaturesToTrack: responses at or under the bar are 0, then the local maxima
+  // of a 3 x 3 dilation, strongest first, each at least min_distance from those before.
+  for (int y = 0; y < image.rows; ++y) {
+    float* e = eig.ptr<float>(y);
+    const float* b = bar.data() + rowCell(y);
+    for (int x = 0; x < image.cols; ++x)
+      if (e[x] <= b[column_cell[x]]) e[x] = 0.f;
+  }
+  cv::dilate(eig, buffers.dilated, cv::Mat());
+  auto& candidates = buffers.candidates;
+  candidates.clear();
+  for (int y = 1; y < image.rows - 1; ++y) {
+    const float* e = eig.ptr<float>(y);
+    const float* d = buffers.dilated.ptr<float>(y);
+    const uchar* m = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    for (int x = 1; x < image.cols - 1; ++x)
+      if (e[x] != 0.f && e[x] == d[x] && (m == nullptr || m[x] != 0))
+        candidates.push_back({e[x], y * image.cols + x});
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  // Spacing on a grid of min_distance cells: only the 3 x 3 cells around a corner can
+  // hold one closer than min_distance.
+  const double spacing = std::max(1.0, min_distance);
+  const int grid_cols = static_cast<int>(std::ceil(image.cols / spacing)) + 1;
+  const int grid_rows = static_cast<int>(std::ceil(image.rows / spacing)) + 1;
+  auto& grid = buffers.grid;
+  grid.resize(static_cast<size_t>(grid_cols * grid_rows));  // (kept capacity: no allocation)
+  for (auto& g : grid) g.clear();
+  const double min2 = min_distance * min_distance;
+  for (const auto& candidate : candidates) {
+    if (max_corners > 0 && corners.size() >= max_corners) break;
+    const cv::Point2f p(static_cast<float>(candidate.second % image.cols),
+                        static_cast<float>(candidate.second / image.cols));
+    const int gx = static_cast<int>(p.x / spacing), gy = static_cast<int>(p.y / spacing);
+    bool apart = true;
+    for (int yy = std::max(0, gy - 1); apart && yy <= std::min(grid_rows - 1, gy + 1); ++yy)
+      for (int xx = std::max(0, gx - 1); apart && xx <= std::min(grid_cols - 1, gx + 1); ++xx)
+        for (const cv::Point2f& q : grid[yy * grid_cols + xx]) {
+          const cv::Point2f d = q - p;
+          if (static_cast<double>(d.x) * d.x + static_cast<double>(d.y) * d.y < min2) {
+            apart = false;
+            break;
+          }
+        }
+    if (!apart) continue;
+    grid[gy * grid_cols + gx].push_back(p);
+    corners.push_back(p);
+  }
+}
+
+bool RelaxedCells::contains(const cv::Point2f& p) const {
+  if (relaxed.empty() || cols <= 0 || cell_px <= 0) return false;
+  const float scale = static_cast<float>(1 << level);
+  const int cx = static_cast<int>(p.x / scale / cell_px);
+  const int cy = static_cast<int>((p.y / scale - top) / cell_px);
+  const int rows = static_cast<int>(relaxed.size()) / cols;
+  if (cx < 0 || cy < 0) return false;
+  return relaxed[std::min(rows - 1, cy) * cols + std::min(cols - 1, cx)] != 0;
 }
 
 double spreadCellPx(const cv::Size& image, int columns) {
@@ -104,6 +298,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   std::vector<cv::Point2f>& corners = buffers.corners;
   corners.clear();
   buffers.from_full_resolution = 0;
+  buffers.relaxed.relaxed.clear();
   if (wanted <= 0) return corners;
   const float scale = static_cast<float>(1 << level);
   // The band on this level (whole rows of it: the band's edges are rows).
@@ -134,10 +329,26 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   const double cell_px = spreadCellPx(full.size(), params.spread_grid_columns);
   const bool spread = cell_px > 0;
   const int pool = spread ? std::max(ask, 4 * params.max_features) : ask;
+  // Per-cell bars (the grid's cells on this level) above the noise floor: then every
+  // candidate goes to the spread, or the strong cells' corners would fill the pool.
+  const cv::Mat searched = level_image(on_level);
+  RelaxedCells& relaxed = buffers.relaxed;
+  relaxed.cell_px = cell_px / scale;
+  relaxed.level = level;
+  relaxed.top = on_level.y;
+  const double noise_floor =
+      spread && params.corner_noise_margin > 0
+          ? params.corner_noise_margin * noiseCornerFloor(searched, level, params.block_size,
+                                                          relaxed.cell_px, &buffers.noise)
+          : 0.0;
   // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
   // the scores at the band's edge are those of the whole image.)
-  cv::goodFeaturesToTrack(level_image(on_level), corners, pool, params.quality_level, min_distance,
-                          mask.empty() ? mask : mask(on_level), params.block_size);
+  shiTomasiCandidates(searched, mask.empty() ? mask : mask(on_level), params.quality_level,
+                      noise_floor, relaxed.cell_px, min_distance, params.block_size,
+                      noise_floor > 0 ? 0 : static_cast<size_t>(pool), buffers.shi_tomasi, corners,
+                      relaxed.relaxed);
+  relaxed.cols =
+      relaxed.relaxed.empty() ? 0 : static_cast<int>(std::ceil(searched.cols / relaxed.cell_px));
   if (corners.empty()) return corners;
   const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
   for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
@@ -162,7 +373,13 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   };
   // First by a block that covers the coarse position's uncertainty (a coarse pixel each
   // way), to refine only the likely ones.
-  if (rank) rankBy(params.block_size + 2 * (1 << level), static_cast<size_t>(2 * wanted + 8));
+  // (With cells' own bars, spread again after ranking: the strongest alone would drop
+  // the weak cells' corners.)
+  if (rank) {
+    const size_t likely = static_cast<size_t>(2 * wanted + 8);
+    rankBy(params.block_size + 2 * (1 << level), noise_floor > 0 ? corners.size() : likely);
+    if (noise_floor > 0) spreadOverCells(corners, live, full.size(), cell_px, likely);
+  }
   // A coarse corner is within a coarse pixel of the true one: the 7x7 window reaches it.
   cv::cornerSubPix(full, corners, cv::Size(3, 3), cv::Size(-1, -1), kSubPixCriteria);
   // Refinement can push a border corner just outside the image.
@@ -176,14 +393,15 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   if (rank) rankBy(params.block_size, corners.size());
   // goodFeaturesToTrack's quality_level is relative to the best corner it sees: in a band,
   // the band's best. The bar of a search of the whole image is set by the best corner
-  // found or live instead.
+  // found or live instead (a cell's own bar does not depend on the band).
   if (derivatives != nullptr && !band.empty()) {
     double best = 0;
     for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
     for (const auto& c : live) best = std::max(best, score(c, params.block_size));
     corners.erase(std::remove_if(corners.begin(), corners.end(),
                                  [&](const cv::Point2f& c) {
-                                   return score(c, params.block_size) < params.quality_level * best;
+                                   return !relaxed.contains(c) &&
+                                          score(c, params.block_size) < params.quality_level * best;
                                  }),
                   corners.end());
   }
@@ -207,7 +425,8 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                 nullptr, band);
     const size_t coarse = found.size();
     for (const auto& c : buffers.corners)
-      if (score(c, params.block_size) >= params.quality_level * best) found.push_back(c);
+      if (buffers.relaxed.contains(c) || score(c, params.block_size) >= params.quality_level * best)
+        found.push_back(c);
     corners = std::move(found);
     buffers.from_full_resolution = static_cast<int>(corners.size() - coarse);
   }

@@ -299,3 +299,101 @@ TEST(CornerSearch, SpreadOverTinyCellsIsBounded) {
   spreadOverCells(corners, {}, {640, 480}, 1e-6, 3);
   EXPECT_EQ(corners, (std::vector<cv::Point2f>{{1, 1}, {100, 100}, {2, 2}}));
 }
+
+namespace {
+
+// White noise of sigma grey levels added to an image (seeded).
+cv::Mat withNoise(const cv::Mat& image, double sigma, unsigned seed) {
+  cv::Mat noise(image.size(), CV_32F), out;
+  cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0, sigma);
+  image.convertTo(out, CV_32F);
+  out += noise;
+  out.convertTo(out, CV_8U);
+  return out;
+}
+
+int insideCount(const std::vector<cv::Point2f>& corners, const cv::Rect& region) {
+  return static_cast<int>(std::count_if(corners.begin(), corners.end(), [&](const cv::Point2f& c) {
+    return region.contains(cv::Point(cvRound(c.x), cvRound(c.y)));
+  }));
+}
+
+}  // namespace
+
+// The noise level is the flattest cell's: texture on three quarters of the image does
+// not raise it, it follows the noise's sigma, and a clipped region is left out.
+TEST(CornerSearch, NoiseLevelIsTheFlattestCellsNoise) {
+  const cv::Mat flat(480, 640, CV_8UC1, cv::Scalar(100));
+  const double plain = noiseLevel(withNoise(flat, 2, 1), 80);
+  // 6 sigma x 0.6745 (the median of a normal's magnitude) for white noise.
+  EXPECT_NEAR(plain, 6 * 0.6745 * 2, 0.1 * plain);
+  cv::Mat textured = squares({640, 480}).image;
+  flat(cv::Rect(0, 0, 160, 480)).copyTo(textured(cv::Rect(0, 0, 160, 480)));
+  EXPECT_NEAR(noiseLevel(withNoise(textured, 2, 2), 80), plain, 0.1 * plain);
+  EXPECT_NEAR(noiseLevel(withNoise(flat, 4, 3), 80), 2 * plain, 0.2 * plain);
+  cv::Mat clipped = withNoise(flat, 2, 4);
+  clipped(cv::Rect(0, 0, 320, 480)).setTo(255);
+  EXPECT_NEAR(noiseLevel(clipped, 80), plain, 0.1 * plain);
+  EXPECT_EQ(noiseLevel(flat, 80), 0.0);  // no noise to measure
+  // The floor follows the noise's variance.
+  EXPECT_NEAR(noiseCornerFloor(withNoise(flat, 4, 5), 0, 3, 80),
+              4 * noiseCornerFloor(withNoise(flat, 2, 6), 0, 3, 80),
+              0.4 * noiseCornerFloor(withNoise(flat, 4, 5), 0, 3, 80));
+}
+
+// Without a noise floor the candidates are goodFeaturesToTrack's, in its order.
+TEST(CornerSearch, CandidatesWithoutAFloorAreGoodFeaturesToTrack) {
+  const cv::Mat image = withNoise(squares({320, 240}).image, 2, 7);
+  std::vector<cv::Point2f> opencv, ours;
+  cv::goodFeaturesToTrack(image, opencv, 0, 0.01, 10.0, cv::noArray(), 3);
+  ShiTomasiBuffers buffers;
+  std::vector<uchar> relaxed;
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0.0, 40, 10.0, 3, 0, buffers, ours, relaxed);
+  ASSERT_GT(opencv.size(), 50u);
+  EXPECT_EQ(ours, opencv);
+  EXPECT_TRUE(relaxed.empty());
+  opencv.resize(20);  // at most max_corners, the strongest
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0.0, 40, 10.0, 3, 20, buffers, ours, relaxed);
+  EXPECT_EQ(ours, opencv);
+}
+
+// Issue 18: a weakly textured patch beside a richly textured one (squares of 10 grey
+// levels against 160: 0.4 % of the strong corners' score, under the image's 1 % bar) gets
+// corners from its cells' own bar, on its true corners; a flat patch with the same noise
+// gets none (the noise floor), nor does it at three times the noise.
+TEST(CornerSearch, AWeakPatchGetsCornersAndAFlatNoisyPatchNone) {
+  const Squares rich = squares({640, 480});
+  cv::Mat image = rich.image.clone();
+  const cv::Rect weak(320, 0, 160, 480), flat(480, 0, 160, 480);
+  image(weak).convertTo(image(weak), CV_8U, 10.0 / 160.0, 40 - 40 * 10.0 / 160.0);
+  image(flat).setTo(40);
+  for (const double sigma : {2.0, 6.0}) {
+    const cv::Mat noisy = withNoise(image, sigma, 8);
+    int levels = 0;
+    const std::vector<cv::Mat> pyramid = pyramidOf(noisy, &levels);
+    TrackerParams params;
+    CornerSearchBuffers buffers;
+    params.corner_noise_margin = 0;  // the image's bar alone: nothing on the weak patch
+    if (sigma == 2.0)
+      EXPECT_EQ(insideCount(
+                    findCorners(noisy, pyramid[2], 1, {}, 150, params, buffers, &pyramid[1]), weak),
+                0);
+    params = TrackerParams();
+    const std::vector<cv::Point2f> corners =
+        findCorners(noisy, pyramid[2], 1, {}, 150, params, buffers, &pyramid[1]);
+    EXPECT_EQ(insideCount(corners, flat), 0) << "sigma " << sigma;
+    if (sigma > 2) continue;  // (three times the noise drowns the 10 grey levels)
+    const int on_weak = insideCount(corners, weak);
+    EXPECT_GE(on_weak, 20);  // (measured 46 of its 96 corners)
+    // On the squares' corners, not on the noise between them (30 px of flat paint): 10
+    // grey levels under noise of 2 place them within a pixel, a few within 4.
+    int within_1px = 0;
+    for (const auto& c : corners) {
+      if (!weak.contains(cv::Point(cvRound(c.x), cvRound(c.y)))) continue;
+      EXPECT_LT(nearest(c, rich.corners), 4.0) << c;
+      within_1px += nearest(c, rich.corners) < 1.0;
+    }
+    EXPECT_GE(within_1px, 0.8 * on_weak);
+    EXPECT_TRUE(buffers.relaxed.contains({400, 240}));
+  }
+}

@@ -36,8 +36,64 @@ double spreadCellPx(const cv::Size& image, int columns);
 void spreadOverCells(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>& live,
                      const cv::Size& image, double cell_px, size_t keep);
 
+// Work buffers of noiseLevel (kept across searches).
+struct NoiseLevelBuffers {
+  cv::Mat response;
+  std::vector<int> histograms, column_cell;
+};
+
+// The image's noise level, as the median |response| of Immerkaer's noise kernel (1996,
+// "Fast noise variance estimation": the difference of two Laplacians, blind to planar
+// shading, 6 sigma for white noise) in the flattest cell of a grid of cell_px squares
+// (<= 0: the whole image), cells whose responses are mostly exactly 0 (clipped, or drawn
+// without noise) left out; 0 when every cell is such. CV_8UC1.
+double noiseLevel(const cv::Mat& image, double cell_px, NoiseLevelBuffers* buffers = nullptr);
+
+// The Shi-Tomasi response (cornerMinEigenVal, block_size, Sobel 3) that the noise of
+// `image` (noiseLevel over cell_px cells, at least half a grey level) does not exceed:
+// the strongest response of white noise of that level over 512 x 512 pixels, shrunk
+// `level` times by pyrDown as `image` was (0: image is full resolution).
+double noiseCornerFloor(const cv::Mat& image, int level, int block_size, double cell_px,
+                        NoiseLevelBuffers* buffers = nullptr);
+
+// The cells of a grid over a searched image whose quality bar the per-cell rule lowered
+// below the image's: their corners were taken relative to the cell's own strongest.
+struct RelaxedCells {
+  std::vector<uchar> relaxed;  // row-major, `cols` per row; empty: none
+  int cols = 0;
+  double cell_px = 0;  // on the searched image
+  int level = 0;       // the searched image is this pyramid level
+  int top = 0;         // its first row on that level (a band)
+  // True when p (full-resolution pixels) lies in a relaxed cell.
+  bool contains(const cv::Point2f& p) const;
+};
+
+// Work buffers of shiTomasiCandidates.
+struct ShiTomasiBuffers {
+  cv::Mat eig, dilated;
+  std::vector<float> bar;
+  std::vector<int> column_cell;
+  std::vector<std::pair<float, int>> candidates;
+  std::vector<std::vector<cv::Point2f>> grid;
+};
+
+// goodFeaturesToTrack (minimum eigenvalue, Sobel 3) with a quality bar per cell of
+// cell_px squares: a pixel is a corner when it is a 3 x 3 local maximum of the response,
+// not masked, and above the lower of the image's bar (quality_level x the strongest
+// unmasked response, the paper's) and its cell's own (quality_level x the cell's
+// strongest, but at least noise_floor). noise_floor <= 0 or cell_px <= 0: the image's bar
+// alone, as goodFeaturesToTrack. Strongest first, each at least min_distance from those
+// before, at most max_corners (0: all). `relaxed` gets the cells whose bar was lowered.
+void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
+                         double noise_floor, double cell_px, double min_distance, int block_size,
+                         size_t max_corners, ShiTomasiBuffers& buffers,
+                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed);
+
 // Buffers kept across searches so that a search allocates nothing they can hold.
 struct CornerSearchBuffers {
+  ShiTomasiBuffers shi_tomasi;
+  NoiseLevelBuffers noise;
+  RelaxedCells relaxed;  // of the last search (the fill's when it ran)
   cv::Mat mask;
   std::vector<cv::Point2f> corners;
   std::vector<std::pair<double, cv::Point2f>> scored;
@@ -59,7 +115,9 @@ double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int bloc
 // holds fewer than `wanted`, full resolution gives the rest. A non-empty `band` (rows of
 // `full`; its x and width are ignored) limits the search to those rows (the tracker
 // spreads a search over two images, a half on each); the quality bar is then set by the
-// best corner found or live (needs `derivatives`), not the band's best.
+// best corner found or live (needs `derivatives`), not the band's best. With
+// params.corner_noise_margin > 0 and a spread grid, each cell of the grid also has its own
+// bar (shiTomasiCandidates), above the noise floor times that margin.
 const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,

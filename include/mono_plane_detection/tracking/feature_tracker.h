@@ -26,6 +26,12 @@ struct TrackerParams {
   // too. The grid has this many columns of square cells whatever the image size
   // (spreadCellPx: 80 px at 640 px wide, 160 px at 1280). 0: strongest first (the paper).
   int spread_grid_columns = 8;
+  // Beyond the paper: each cell of that grid also takes corners above quality_level of
+  // its own strongest response (the image's bar is relative to the strongest corner of the
+  // whole image, so a plain cabinet front beside photographs gets none), but never under
+  // this many times the strongest response of the image's noise (noiseCornerFloor). 0: the
+  // image's bar alone (the paper).
+  double corner_noise_margin = 2.0;
 
   // Pyramidal Lucas-Kanade (paper II-C).
   int pyramid_levels = 5;             // levels including full resolution (paper: 5)
