@@ -705,8 +705,12 @@ double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& vi
     if (below + (n - b1) <= kth) return std::numeric_limits<double>::infinity();
   }
   if (below <= kth) return std::numeric_limits<double>::infinity();
-  std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
-  return std::sqrt(r[kth]);
+  // NaN (non-finite points) has no order: nth_element's answer kept for it.
+  if (std::any_of(r.begin(), r.end(), [](double v) { return std::isnan(v); })) {
+    std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
+    return std::sqrt(r[kth]);
+  }
+  return std::sqrt(kthNonNegative(r, kth));
 }
 
 // Groups drawn as findCoplanarGroups draws them (GroupSampler, repeats skipped), each with

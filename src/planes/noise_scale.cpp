@@ -1,6 +1,9 @@
 #include "mono_plane_detection/planes/noise_scale.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -14,51 +17,108 @@ namespace {
 // msseScale on squared residuals (the same order and stop, without a square root per
 // residual and per inlier count: the pilot runs 55-73 of these per image pair), also
 // giving the largest inlier's squared residual (the inlier set's cut).
-// expected: about how many inliers there will be (the last estimate's on a refit), 0
-// unknown; only how much is sorted first depends on it, not the result.
 NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model_dof,
-                       double stop_sigmas, double* cut, size_t expected = 0) {
+                       double stop_sigmas, double* cut) {
   residuals.erase(std::remove_if(residuals.begin(), residuals.end(),
                                  [](double r) { return !std::isfinite(r); }),
                   residuals.end());
   const int n = static_cast<int>(residuals.size());
   min_inliers = std::max(min_inliers, model_dof / 2 + 1);  // 2k - dof > 0
   if (n < min_inliers) return {};
-  // Sorted lazily: the smallest part first (half, or a quarter more than the expected
-  // inliers), then twice as much each time the inliers reach beyond it (a good candidate
-  // stops early; this runs for every pilot candidate and refit, and sorting was most of it).
-  const size_t first = expected > 0 ? expected + expected / 4 + 2 : static_cast<size_t>(n) / 2;
-  size_t sorted = std::min<size_t>(n, std::max<size_t>(2 * min_inliers, first));
-  std::nth_element(residuals.begin(), residuals.begin() + static_cast<long>(sorted) - 1,
-                   residuals.end());
-  std::sort(residuals.begin(), residuals.begin() + static_cast<long>(sorted));
-  auto ensure = [&](int k) {
-    while (static_cast<size_t>(k) >= sorted) {
-      const size_t more = std::min(residuals.size(), 2 * sorted);
-      std::nth_element(residuals.begin() + static_cast<long>(sorted),
-                       residuals.begin() + static_cast<long>(more) - 1, residuals.end());
-      std::sort(residuals.begin() + static_cast<long>(sorted),
-                residuals.begin() + static_cast<long>(more));
-      sorted = more;
-    }
-  };
+  // All sorted at once by sortNonNegative (linear but for a few inversions): cheaper than
+  // std::sort's half that the stop needed at most, whose branches were most of the time.
+  sortNonNegative(residuals);
   const double stop2 = stop_sigmas * stop_sigmas;
   double sum = 0.0;
   for (int k = 1; k <= n; ++k) {
-    ensure(k - 1);
     sum += residuals[k - 1];
     if (k < min_inliers) continue;
     // r_k^2 > stop^2 sigma^2 with sigma^2 = sum / (2k - dof), without the division.
     const double dof = 2.0 * k - model_dof;
     *cut = residuals[k - 1];
     if (k == n) return {std::sqrt(sum / dof), k};
-    ensure(k);
     if (residuals[k] * dof > stop2 * sum) return {std::sqrt(sum / dof), k};
   }
   return {};
 }
 
+// Buckets of sortNonNegative and kthNonNegative: the bits of a non-negative double above
+// its 3 leading mantissa bits (eighths of an octave). At most kMaxBuckets below the largest
+// finite value's; smaller values share the first bucket, +infinity and NaN the last.
+constexpr int kBucketShift = 49;
+constexpr uint32_t kInfinityBucket = 0x7FF0000000000000ull >> kBucketShift;
+constexpr uint32_t kMaxBuckets = 512;
+
+uint32_t bucketBits(double v) {
+  uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return static_cast<uint32_t>(b >> kBucketShift);
+}
+
+struct Buckets {
+  uint32_t lo = 0, hi = 0;
+  explicit Buckets(const std::vector<double>& values) {
+    uint32_t top = 0, bottom = kInfinityBucket;
+    for (double v : values) {
+      const uint32_t b = bucketBits(v);
+      if (b >= kInfinityBucket) continue;  // not finite: the last bucket
+      top = std::max(top, b);
+      bottom = std::min(bottom, b);
+    }
+    bottom = std::min(bottom, top);  // (none finite)
+    hi = top;
+    lo = std::max(bottom, top >= kMaxBuckets ? top - (kMaxBuckets - 1) : 0u);
+  }
+  uint32_t size() const { return std::min(hi - lo + 1, kMaxBuckets); }  // (never more)
+  // Monotone in the value: the order of the buckets is the order of the values.
+  uint32_t operator()(double v) const { return std::clamp(bucketBits(v), lo, hi) - lo; }
+};
+
 }  // namespace
+
+void sortNonNegative(std::vector<double>& values) {
+  const size_t n = values.size();
+  if (n < 32) {
+    std::sort(values.begin(), values.end());
+    return;
+  }
+  const Buckets bucket(values);
+  std::array<uint32_t, kMaxBuckets + 1> start;
+  std::fill(start.begin(), start.begin() + bucket.size() + 1, 0u);
+  for (double v : values) ++start[bucket(v) + 1];
+  for (uint32_t b = 1; b <= bucket.size(); ++b) start[b] += start[b - 1];
+  std::vector<double> out(n);
+  for (double v : values) out[start[bucket(v)]++] = v;
+  // In bucket order: only values within a bucket are out of order.
+  for (size_t i = 1; i < n; ++i) {
+    const double v = out[i];
+    size_t j = i;
+    for (; j > 0 && v < out[j - 1]; --j) out[j] = out[j - 1];
+    out[j] = v;
+  }
+  values.swap(out);
+}
+
+double kthNonNegative(std::vector<double>& values, size_t k) {
+  if (values.size() < 64) {
+    std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
+    return values[k];
+  }
+  const Buckets bucket(values);
+  std::array<uint32_t, kMaxBuckets> count;
+  std::fill(count.begin(), count.begin() + bucket.size(), 0u);
+  for (double v : values) ++count[bucket(v)];
+  uint32_t b = 0;
+  size_t before = 0;
+  while (before + count[b] <= k) before += count[b++];
+  // Only the values of the k-th's bucket, moved to the front, are selected among.
+  size_t m = 0;
+  for (size_t i = 0; i < values.size(); ++i)
+    if (bucket(values[i]) == b) std::swap(values[m++], values[i]);
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(k - before),
+                   values.begin() + static_cast<long>(m));
+  return values[k - before];
+}
 
 NoiseScale msseScale(std::vector<double> residuals, int min_inliers, int model_dof,
                      double stop_sigmas) {
@@ -196,8 +256,7 @@ const RefitStep& refitStep(const std::vector<char>& in, const std::vector<cv::Po
     step.fitted = true;
     step.H = *refit;
     step.r = squaredResiduals(*refit, view1, view2);
-    step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut,
-                             static_cast<size_t>(std::count(in.begin(), in.end(), 1)));
+    step.scale = msseWithCut(step.r, params.min_inliers, 8, params.stop_sigmas, &step.cut);
   }
   memo.push_back(std::move(step));
   return memo.back();
