@@ -35,10 +35,10 @@ bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p
 // sends a to infinity.
 double squaredTransfer(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b) {
   const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-  if (!(std::abs(w) >= 1e-12)) return std::numeric_limits<double>::infinity();
   const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
   const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
-  return (dx * dx + dy * dy) / (w * w);
+  const double e2 = (dx * dx + dy * dy) / (w * w);
+  return std::abs(w) >= 1e-12 ? e2 : std::numeric_limits<double>::infinity();  // a select
 }
 
 // Cauchy weight 1 / (1 + (r / scale)^2) of a point's transfer error r (0 at infinity).
@@ -152,9 +152,15 @@ std::vector<int> activeIndices(const std::vector<bool>& active, size_t n) {
 std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                               const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
                               double threshold_px) {
-  std::vector<int> inliers;
-  for (int i : among)
-    if (transfersWithin(H, view1[i], view2[i], threshold_px)) inliers.push_back(i);
+  // Written without a branch per point (each index stored, kept when within): the refits
+  // of the merge and the assignment call this over hundreds of points, half of them in.
+  std::vector<int> inliers(among.size());
+  size_t kept = 0;
+  for (int i : among) {
+    inliers[kept] = i;
+    kept += transfersWithin(H, view1[i], view2[i], threshold_px);
+  }
+  inliers.resize(kept);
   return inliers;
 }
 
@@ -205,8 +211,9 @@ struct Energy {
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
     const double e2 = squaredTransfer(p.H, a, b);
-    if (!(e2 < p.threshold_px * p.threshold_px)) return k2;
-    return std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
+    // As selects: every point and plane of the assignment's table, no pattern to predict.
+    const double inside = std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
+    return e2 < p.threshold_px * p.threshold_px ? inside : k2;
   }
   double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
@@ -438,14 +445,11 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
       double best = energy.k2, second = energy.k2;
       long label = -1;
       for (size_t k = 0; k < alive.size(); ++k) {
+        // The two least costs and the first least's plane, as selects (no branch).
         const double e = c[alive[k]];
-        if (e < best) {
-          second = best;
-          best = e;
-          label = static_cast<long>(k);
-        } else {
-          second = std::min(second, e);
-        }
+        label = e < best ? static_cast<long>(k) : label;
+        second = std::min(second, std::max(best, e));
+        best = std::min(best, e);
       }
       if (label < 0) continue;
       members[static_cast<size_t>(label)].push_back(static_cast<int>(i));

@@ -200,10 +200,10 @@ NoiseScale medianScaleSquared(const std::vector<double>& residuals, double sigma
     if (cut > bound) {  // the residuals in [bound, cut) join the sorted ones, after them
       const auto mid =
           std::partition(rest.begin(), rest.end(), [cut](double r) { return r < cut; });
-      const size_t old = sorted.size();
-      sorted.insert(sorted.end(), rest.begin(), mid);
+      std::vector<double> joining(rest.begin(), mid);
+      sortNonNegative(joining);  // (squared: non-negative)
+      sorted.insert(sorted.end(), joining.begin(), joining.end());
       rest.erase(rest.begin(), mid);
-      std::sort(sorted.begin() + static_cast<long>(old), sorted.end());
       bound = cut;
     }
     const size_t in = static_cast<size_t>(std::lower_bound(sorted.begin(), sorted.end(), cut) -
