@@ -43,35 +43,37 @@ NoiseScale msseWithCut(std::vector<double> residuals, int min_inliers, int model
 }
 
 // Buckets of sortNonNegative and kthNonNegative: the bits of a non-negative double above
-// its 3 leading mantissa bits (eighths of an octave). At most kMaxBuckets below the largest
-// finite value's; smaller values share the first bucket, +infinity and NaN the last.
-constexpr int kBucketShift = 49;
-constexpr uint32_t kInfinityBucket = 0x7FF0000000000000ull >> kBucketShift;
-constexpr uint32_t kMaxBuckets = 512;
-
-uint32_t bucketBits(double v) {
-  uint64_t b;
-  std::memcpy(&b, &v, sizeof b);
-  return static_cast<uint32_t>(b >> kBucketShift);
-}
+// its 3 leading mantissa bits (eighths of an octave; 5 bits, 32ths, from 400 values on,
+// so that a bucket holds a few). At most 64 octaves of buckets below the largest finite
+// value's; smaller values share the first bucket, +infinity and NaN the last.
+constexpr uint32_t kMaxBuckets = 2048;
 
 struct Buckets {
+  int shift = 49;
   uint32_t lo = 0, hi = 0;
   explicit Buckets(const std::vector<double>& values) {
-    uint32_t top = 0, bottom = kInfinityBucket;
+    shift = values.size() >= 400 ? 47 : 49;
+    const uint32_t infinity_bucket = bits(std::numeric_limits<double>::infinity());
+    const uint32_t max_buckets = 64u << (52 - shift);  // 64 octaves
+    uint32_t top = 0, bottom = infinity_bucket;
     for (double v : values) {
-      const uint32_t b = bucketBits(v);
-      if (b >= kInfinityBucket) continue;  // not finite: the last bucket
+      const uint32_t b = bits(v);
+      if (b >= infinity_bucket) continue;  // not finite: the last bucket
       top = std::max(top, b);
       bottom = std::min(bottom, b);
     }
     bottom = std::min(bottom, top);  // (none finite)
     hi = top;
-    lo = std::max(bottom, top >= kMaxBuckets ? top - (kMaxBuckets - 1) : 0u);
+    lo = std::max(bottom, top >= max_buckets ? top - (max_buckets - 1) : 0u);
+  }
+  uint32_t bits(double v) const {
+    uint64_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return static_cast<uint32_t>(b >> shift);
   }
   uint32_t size() const { return std::min(hi - lo + 1, kMaxBuckets); }  // (never more)
   // Monotone in the value: the order of the buckets is the order of the values.
-  uint32_t operator()(double v) const { return std::clamp(bucketBits(v), lo, hi) - lo; }
+  uint32_t operator()(double v) const { return std::clamp(bits(v), lo, hi) - lo; }
 };
 
 }  // namespace
