@@ -51,6 +51,12 @@ double cauchyWeight(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2
 // Points' coordinates in separate arrays, for counting votes in vector instructions.
 struct PointArrays {
   std::vector<double> ax, ay, bx, by;
+  void reserve(size_t n) {
+    ax.reserve(n);
+    ay.reserve(n);
+    bx.reserve(n);
+    by.reserve(n);
+  }
   void add(const cv::Point2d& a, const cv::Point2d& b) {
     ax.push_back(a.x);
     ay.push_back(a.y);
@@ -428,14 +434,40 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
   const size_t n = view1.size();
   std::vector<size_t> alive(planes.size());
   std::iota(alive.begin(), alive.end(), 0);
-  std::vector<double> cost(n * planes.size(), energy.k2);
-  for (size_t k = 0; k < planes.size(); ++k) {
-    const double width = energy.widthCost(planes[k]);
-    for (size_t i = 0; i < n; ++i)
-      if (finite(view1[i]) && finite(view2[i]))
-        cost[i * planes.size() + k] = energy.point(planes[k], view1[i], view2[i], width);
-  }
+  // Energy::point's arithmetic over coordinate arrays, a plane at a time, so that it
+  // compiles to vector instructions (the same values; non-finite points cost k^2).
   const size_t stride = planes.size();
+  std::vector<double> cost(n * stride);
+  PointArrays p;
+  p.reserve(n);
+  std::vector<char> usable(n);
+  for (size_t i = 0; i < n; ++i) {
+    usable[i] = finite(view1[i]) && finite(view2[i]);
+    p.add(usable[i] ? view1[i] : cv::Point2d(), usable[i] ? view2[i] : cv::Point2d());
+  }
+  std::vector<double> row(n);
+  for (size_t k = 0; k < stride; ++k) {
+    const cv::Matx33d& H = planes[k].H;
+    const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
+                 h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+    const double width = energy.widthCost(planes[k]), k2 = energy.k2;
+    const double noise2 = planes[k].noise_px * planes[k].noise_px;
+    const double t2 = planes[k].threshold_px * planes[k].threshold_px;
+    const double* ax = p.ax.data();
+    const double* ay = p.ay.data();
+    const double* bx = p.bx.data();
+    const double* by = p.by.data();
+    for (size_t i = 0; i < n; ++i) {
+      const double w = h6 * ax[i] + h7 * ay[i] + h8;
+      const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
+      const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
+      const double q = (dx * dx + dy * dy) / (w * w);
+      const double e2 = std::abs(w) >= 1e-12 ? q : std::numeric_limits<double>::infinity();
+      const double inside = std::min(e2 / noise2 + width, k2);
+      row[i] = e2 < t2 ? inside : k2;
+    }
+    for (size_t i = 0; i < n; ++i) cost[i * stride + k] = usable[i] ? row[i] : energy.k2;
+  }
   for (;;) {
     std::vector<std::vector<int>> members(alive.size());
     std::vector<double> gain(alive.size(), -energy.plane_cost);
@@ -915,6 +947,7 @@ class RepeatedVote {
     std::stable_sort(unknown.begin(), unknown.end(),
                      [this](int a, int b) { return bound_[a] > bound_[b]; });
     PointArrays points;
+    points.reserve(order_.size());
     for (int i : order_)
       if (active[i]) points.add(view1_[i], view2_[i]);
     const double t2 = threshold_px_ * threshold_px_;
