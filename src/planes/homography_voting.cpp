@@ -461,10 +461,12 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
       const double w = h6 * ax[i] + h7 * ay[i] + h8;
       const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
       const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
-      const double q = (dx * dx + dy * dy) / (w * w);
-      const double e2 = std::abs(w) >= 1e-12 ? q : std::numeric_limits<double>::infinity();
-      const double inside = std::min(e2 / noise2 + width, k2);
-      row[i] = e2 < t2 ? inside : k2;
+      // (As in votesInBlock: the conditions joined by &, one select, or GCC keeps the
+      // branches and the loop scalar.) |w| < 1e-12 is squaredTransfer's infinity: k^2.
+      const double e2 = (dx * dx + dy * dy) / (w * w);
+      const double c = e2 / noise2 + width;
+      const double inside = k2 < c ? k2 : c;  // std::min(c, k2)
+      row[i] = (std::abs(w) >= 1e-12) & (e2 < t2) ? inside : k2;
     }
     for (size_t i = 0; i < n; ++i) cost[i * stride + k] = usable[i] ? row[i] : energy.k2;
   }
