@@ -231,6 +231,44 @@ struct Energy {
   }
 };
 
+// Energy::point for every point of p (the same values), written so that it compiles to
+// vector instructions: the conditions joined by & and one select (as in votesInBlock;
+// with branches GCC keeps the loop scalar). |w| < 1e-12 is squaredTransfer's infinity,
+// a non-finite point's NaN fails e2 < t2: both cost k^2, as in Energy::point.
+void pointCosts(const Energy& energy, const HomographyPlane& plane, double width,
+                const PointArrays& p, std::vector<double>& out) {
+  const size_t n = p.size();
+  out.resize(n);
+  const cv::Matx33d& H = plane.H;
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
+               h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double k2 = energy.k2;
+  const double noise2 = plane.noise_px * plane.noise_px;
+  const double t2 = plane.threshold_px * plane.threshold_px;
+  const double* ax = p.ax.data();
+  const double* ay = p.ay.data();
+  const double* bx = p.bx.data();
+  const double* by = p.by.data();
+  double* row = out.data();
+  for (size_t i = 0; i < n; ++i) {
+    const double w = h6 * ax[i] + h7 * ay[i] + h8;
+    const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
+    const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
+    const double e2 = (dx * dx + dy * dy) / (w * w);
+    const double c = e2 / noise2 + width;
+    const double inside = k2 < c ? k2 : c;  // std::min(c, k2)
+    row[i] = (std::abs(w) >= 1e-12) & (e2 < t2) ? inside : k2;
+  }
+}
+
+PointArrays arraysOf(const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
+                     const std::vector<cv::Point2d>& view2) {
+  PointArrays p;
+  p.reserve(idx.size());
+  for (int i : idx) p.add(view1[i], view2[i]);
+  return p;
+}
+
 // The plane's noise scale from its residuals over the points (medianScale from the
 // image pair's scale, kept within a factor 4 of it), and its threshold.
 void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1,
@@ -273,17 +311,19 @@ bool mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
         const double union_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
         // plane does not explain may go to a third plane or become an outlier).
-        std::vector<double> others(both.size(), energy.k2);
-        double separate = 0.0;
-        for (size_t q = 0; q < both.size(); ++q) {
-          const int x = both[q];
-          for (size_t m = 0; m < planes.size(); ++m)
-            if (m != i && m != j)
-              others[q] =
-                  std::min(others[q], energy.point(planes[m], view1[x], view2[x], widths[m]));
-          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x], widths[i]),
-                                energy.point(planes[j], view1[x], view2[x], widths[j])});
+        // (Each plane's costs over the two's points by pointCosts, then combined in the
+        // same order as point by point.)
+        const PointArrays both_points = arraysOf(both, view1, view2);
+        std::vector<double> others(both.size(), energy.k2), ci, cj, cm;
+        for (size_t m = 0; m < planes.size(); ++m) {
+          if (m == i || m == j) continue;
+          pointCosts(energy, planes[m], widths[m], both_points, cm);
+          for (size_t q = 0; q < both.size(); ++q) others[q] = std::min(others[q], cm[q]);
         }
+        pointCosts(energy, planes[i], widths[i], both_points, ci);
+        pointCosts(energy, planes[j], widths[j], both_points, cj);
+        double separate = 0.0;
+        for (size_t q = 0; q < both.size(); ++q) separate += std::min({others[q], ci[q], cj[q]});
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
         // alone can stay with its own piece.
@@ -304,9 +344,8 @@ bool mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           m.threshold_px = union_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
-          const double width = energy.widthCost(m);
-          for (size_t q = 0; q < both.size(); ++q)
-            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]], width));
+          pointCosts(energy, m, energy.widthCost(m), both_points, cm);
+          for (size_t q = 0; q < both.size(); ++q) cost += std::min(others[q], cm[q]);
           if (cost < together) {
             together = cost;
             merged = m;
@@ -404,12 +443,14 @@ bool splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     const int b = best_candidate(rest, members.size());
     if (b < 0 || !make(b, rest, B)) continue;
     double split_cost = 2.0 * energy.plane_cost, whole_cost = energy.plane_cost;
-    const double wa = energy.widthCost(A), wb = energy.widthCost(B),
-                 ww = energy.widthCost(planes[p]);
-    for (int i : members) {
-      split_cost += std::min(energy.point(A, view1[i], view2[i], wa),
-                             energy.point(B, view1[i], view2[i], wb));
-      whole_cost += energy.point(planes[p], view1[i], view2[i], ww);
+    const PointArrays member_points = arraysOf(members, view1, view2);
+    std::vector<double> ca, cb, cw;
+    pointCosts(energy, A, energy.widthCost(A), member_points, ca);
+    pointCosts(energy, B, energy.widthCost(B), member_points, cb);
+    pointCosts(energy, planes[p], energy.widthCost(planes[p]), member_points, cw);
+    for (size_t q = 0; q < members.size(); ++q) {
+      split_cost += std::min(ca[q], cb[q]);
+      whole_cost += cw[q];
     }
     if (split_cost >= whole_cost) continue;
     planes[p] = A;
@@ -434,8 +475,7 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
   const size_t n = view1.size();
   std::vector<size_t> alive(planes.size());
   std::iota(alive.begin(), alive.end(), 0);
-  // Energy::point's arithmetic over coordinate arrays, a plane at a time, so that it
-  // compiles to vector instructions (the same values; non-finite points cost k^2).
+  // pointCosts a plane at a time (non-finite points cost k^2).
   const size_t stride = planes.size();
   std::vector<double> cost(n * stride);
   PointArrays p;
@@ -447,27 +487,7 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
   }
   std::vector<double> row(n);
   for (size_t k = 0; k < stride; ++k) {
-    const cv::Matx33d& H = planes[k].H;
-    const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
-                 h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
-    const double width = energy.widthCost(planes[k]), k2 = energy.k2;
-    const double noise2 = planes[k].noise_px * planes[k].noise_px;
-    const double t2 = planes[k].threshold_px * planes[k].threshold_px;
-    const double* ax = p.ax.data();
-    const double* ay = p.ay.data();
-    const double* bx = p.bx.data();
-    const double* by = p.by.data();
-    for (size_t i = 0; i < n; ++i) {
-      const double w = h6 * ax[i] + h7 * ay[i] + h8;
-      const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
-      const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
-      // (As in votesInBlock: the conditions joined by &, one select, or GCC keeps the
-      // branches and the loop scalar.) |w| < 1e-12 is squaredTransfer's infinity: k^2.
-      const double e2 = (dx * dx + dy * dy) / (w * w);
-      const double c = e2 / noise2 + width;
-      const double inside = k2 < c ? k2 : c;  // std::min(c, k2)
-      row[i] = (std::abs(w) >= 1e-12) & (e2 < t2) ? inside : k2;
-    }
+    pointCosts(energy, planes[k], energy.widthCost(planes[k]), p, row);
     for (size_t i = 0; i < n; ++i) cost[i * stride + k] = usable[i] ? row[i] : energy.k2;
   }
   for (;;) {
