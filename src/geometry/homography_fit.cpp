@@ -46,7 +46,8 @@ void normalisers(const std::vector<cv::Point2d>& p, const std::vector<cv::Point2
     spread_p += (Eigen::Vector2d(p[i].x, p[i].y) - mean_p).norm();
     spread_q += (Eigen::Vector2d(q[i].x, q[i].y) - mean_q).norm();
   }
-  auto make = [](double spread, size_t n, const Eigen::Vector2d& mean) -> std::optional<Eigen::Matrix3d> {
+  auto make = [](double spread, size_t n,
+                 const Eigen::Vector2d& mean) -> std::optional<Eigen::Matrix3d> {
     spread /= static_cast<double>(n);
     if (!(spread > 1e-12) || !std::isfinite(spread)) return std::nullopt;
     const double s = std::sqrt(2.0) / spread;

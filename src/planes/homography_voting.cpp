@@ -240,8 +240,8 @@ void pointCosts(const Energy& energy, const HomographyPlane& plane, double width
   const size_t n = p.size();
   out.resize(n);
   const cv::Matx33d& H = plane.H;
-  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1),
-               h5 = H(1, 2), h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1), h5 = H(1, 2),
+               h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
   const double k2 = energy.k2;
   const double noise2 = plane.noise_px * plane.noise_px;
   const double t2 = plane.threshold_px * plane.threshold_px;
