@@ -23,6 +23,42 @@ std::optional<Eigen::Matrix3d> normaliser(const std::vector<cv::Point2d>& p) {
   return T;
 }
 
+// normaliser of both point sets in one pass each over the points: the same sums in the
+// same order (the same result), but two independent chains of additions at a time
+// instead of one (the refits' normalisers were a twentieth of the plane core at 1000
+// points, bound by the additions' latency).
+void normalisers(const std::vector<cv::Point2d>& p, const std::vector<cv::Point2d>& q,
+                 std::optional<Eigen::Matrix3d>& tp, std::optional<Eigen::Matrix3d>& tq) {
+  if (p.size() != q.size()) {
+    tp = normaliser(p);
+    tq = normaliser(q);
+    return;
+  }
+  Eigen::Vector2d mean_p = Eigen::Vector2d::Zero(), mean_q = Eigen::Vector2d::Zero();
+  for (size_t i = 0; i < p.size(); ++i) {
+    mean_p += Eigen::Vector2d(p[i].x, p[i].y);
+    mean_q += Eigen::Vector2d(q[i].x, q[i].y);
+  }
+  mean_p /= static_cast<double>(p.size());
+  mean_q /= static_cast<double>(q.size());
+  double spread_p = 0.0, spread_q = 0.0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    spread_p += (Eigen::Vector2d(p[i].x, p[i].y) - mean_p).norm();
+    spread_q += (Eigen::Vector2d(q[i].x, q[i].y) - mean_q).norm();
+  }
+  auto make = [](double spread, size_t n,
+                 const Eigen::Vector2d& mean) -> std::optional<Eigen::Matrix3d> {
+    spread /= static_cast<double>(n);
+    if (!(spread > 1e-12) || !std::isfinite(spread)) return std::nullopt;
+    const double s = std::sqrt(2.0) / spread;
+    Eigen::Matrix3d T;
+    T << s, 0, -s * mean.x(), 0, s, -s * mean.y(), 0, 0, 1;
+    return T;
+  };
+  tp = make(spread_p, p.size(), mean_p);
+  tq = make(spread_q, q.size(), mean_q);
+}
+
 using Matrix9d = Eigen::Matrix<double, 9, 9>;
 using Vector9d = Eigen::Matrix<double, 9, 1>;
 
@@ -109,8 +145,8 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
                                          const std::vector<double>& weights) {
   const size_t n = from.size();
   if (n < 4 || to.size() != n || (!weights.empty() && weights.size() != n)) return std::nullopt;
-  const auto Tf = normaliser(from);
-  const auto Tt = normaliser(to);
+  std::optional<Eigen::Matrix3d> Tf, Tt;
+  normalisers(from, to, Tf, Tt);
   if (!Tf || !Tt) return std::nullopt;
 
   // The normal matrix A^T W A summed over points. A point's two DLT rows are

@@ -96,8 +96,9 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
   // The k nearest at the floor distance or more (squared distances: same order; ties by
   // index) in a short sorted list, searched on the grid: the same list as one scan of
   // the seed's row of the distance matrix, which took up to a quarter of the plane stage.
+  std::vector<std::pair<double, int>>& best = nearest_;  // (reused: no allocation per seed)
   auto nearest = [&](double floor2) {
-    std::vector<std::pair<double, int>> best;
+    best.clear();
     best.reserve(k + 1);
     // worst2: the k-th distance so far (infinity until k are in), a single comparison
     // rejecting most points once the list is full.
@@ -117,7 +118,7 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
     };
     if (cell_start_.empty()) {
       for (int j = 0; j < n; ++j) consider(j);
-      return best;
+      return;
     }
     // Rings of cells around the seed's cell: after ring q every point nearer than q
     // cells is considered, so the search stops once the k-th distance is below that.
@@ -142,11 +143,11 @@ std::vector<int>& GroupSampler::neighboursOf(size_t slot) {
       const double reach = q * cell_px_;
       if (best.size() == k && best.back().first <= reach * reach) break;
     }
-    return best;
   };
   const double min_distance = params_.min_neighbour_distance_px;
-  std::vector<std::pair<double, int>> best = nearest(min_distance * min_distance);
-  if (best.size() < 4) best = nearest(-1.0);
+  nearest(min_distance * min_distance);
+  if (best.size() < 4) nearest(-1.0);
+  near.reserve(best.size());
   for (const auto& b : best) near.push_back(b.second);
   return near;
 }

@@ -35,10 +35,10 @@ bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p
 // sends a to infinity.
 double squaredTransfer(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b) {
   const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-  if (!(std::abs(w) >= 1e-12)) return std::numeric_limits<double>::infinity();
   const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
   const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
-  return (dx * dx + dy * dy) / (w * w);
+  const double e2 = (dx * dx + dy * dy) / (w * w);
+  return std::abs(w) >= 1e-12 ? e2 : std::numeric_limits<double>::infinity();  // a select
 }
 
 // Cauchy weight 1 / (1 + (r / scale)^2) of a point's transfer error r (0 at infinity).
@@ -51,6 +51,12 @@ double cauchyWeight(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2
 // Points' coordinates in separate arrays, for counting votes in vector instructions.
 struct PointArrays {
   std::vector<double> ax, ay, bx, by;
+  void reserve(size_t n) {
+    ax.reserve(n);
+    ay.reserve(n);
+    bx.reserve(n);
+    by.reserve(n);
+  }
   void add(const cv::Point2d& a, const cv::Point2d& b) {
     ax.push_back(a.x);
     ay.push_back(a.y);
@@ -152,9 +158,15 @@ std::vector<int> activeIndices(const std::vector<bool>& active, size_t n) {
 std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                               const std::vector<cv::Point2d>& view2, const std::vector<int>& among,
                               double threshold_px) {
-  std::vector<int> inliers;
-  for (int i : among)
-    if (transfersWithin(H, view1[i], view2[i], threshold_px)) inliers.push_back(i);
+  // Written without a branch per point (each index stored, kept when within): the refits
+  // of the merge and the assignment call this over hundreds of points, half of them in.
+  std::vector<int> inliers(among.size());
+  size_t kept = 0;
+  for (int i : among) {
+    inliers[kept] = i;
+    kept += transfersWithin(H, view1[i], view2[i], threshold_px);
+  }
+  inliers.resize(kept);
   return inliers;
 }
 
@@ -205,8 +217,9 @@ struct Energy {
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
     const double e2 = squaredTransfer(p.H, a, b);
-    if (!(e2 < p.threshold_px * p.threshold_px)) return k2;
-    return std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
+    // As selects: every point and plane of the assignment's table, no pattern to predict.
+    const double inside = std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
+    return e2 < p.threshold_px * p.threshold_px ? inside : k2;
   }
   double widthCost(const HomographyPlane& p) const { return 4.0 * std::log(p.noise_px / sigma); }
   double sum(const HomographyPlane& p, const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
@@ -217,6 +230,44 @@ struct Energy {
     return e;
   }
 };
+
+// Energy::point for every point of p (the same values), written so that it compiles to
+// vector instructions: the conditions joined by & and one select (as in votesInBlock;
+// with branches GCC keeps the loop scalar). |w| < 1e-12 is squaredTransfer's infinity,
+// a non-finite point's NaN fails e2 < t2: both cost k^2, as in Energy::point.
+void pointCosts(const Energy& energy, const HomographyPlane& plane, double width,
+                const PointArrays& p, std::vector<double>& out) {
+  const size_t n = p.size();
+  out.resize(n);
+  const cv::Matx33d& H = plane.H;
+  const double h0 = H(0, 0), h1 = H(0, 1), h2 = H(0, 2), h3 = H(1, 0), h4 = H(1, 1), h5 = H(1, 2),
+               h6 = H(2, 0), h7 = H(2, 1), h8 = H(2, 2);
+  const double k2 = energy.k2;
+  const double noise2 = plane.noise_px * plane.noise_px;
+  const double t2 = plane.threshold_px * plane.threshold_px;
+  const double* ax = p.ax.data();
+  const double* ay = p.ay.data();
+  const double* bx = p.bx.data();
+  const double* by = p.by.data();
+  double* row = out.data();
+  for (size_t i = 0; i < n; ++i) {
+    const double w = h6 * ax[i] + h7 * ay[i] + h8;
+    const double dx = (h0 * ax[i] + h1 * ay[i] + h2) - bx[i] * w;
+    const double dy = (h3 * ax[i] + h4 * ay[i] + h5) - by[i] * w;
+    const double e2 = (dx * dx + dy * dy) / (w * w);
+    const double c = e2 / noise2 + width;
+    const double inside = k2 < c ? k2 : c;  // std::min(c, k2)
+    row[i] = (std::abs(w) >= 1e-12) & (e2 < t2) ? inside : k2;
+  }
+}
+
+PointArrays arraysOf(const std::vector<int>& idx, const std::vector<cv::Point2d>& view1,
+                     const std::vector<cv::Point2d>& view2) {
+  PointArrays p;
+  p.reserve(idx.size());
+  for (int i : idx) p.add(view1[i], view2[i]);
+  return p;
+}
 
 // The plane's noise scale from its residuals over the points (medianScale from the
 // image pair's scale, kept within a factor 4 of it), and its threshold.
@@ -260,17 +311,19 @@ bool mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
         const double union_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
         // plane does not explain may go to a third plane or become an outlier).
-        std::vector<double> others(both.size(), energy.k2);
-        double separate = 0.0;
-        for (size_t q = 0; q < both.size(); ++q) {
-          const int x = both[q];
-          for (size_t m = 0; m < planes.size(); ++m)
-            if (m != i && m != j)
-              others[q] =
-                  std::min(others[q], energy.point(planes[m], view1[x], view2[x], widths[m]));
-          separate += std::min({others[q], energy.point(planes[i], view1[x], view2[x], widths[i]),
-                                energy.point(planes[j], view1[x], view2[x], widths[j])});
+        // (Each plane's costs over the two's points by pointCosts, then combined in the
+        // same order as point by point.)
+        const PointArrays both_points = arraysOf(both, view1, view2);
+        std::vector<double> others(both.size(), energy.k2), ci, cj, cm;
+        for (size_t m = 0; m < planes.size(); ++m) {
+          if (m == i || m == j) continue;
+          pointCosts(energy, planes[m], widths[m], both_points, cm);
+          for (size_t q = 0; q < both.size(); ++q) others[q] = std::min(others[q], cm[q]);
         }
+        pointCosts(energy, planes[i], widths[i], both_points, ci);
+        pointCosts(energy, planes[j], widths[j], both_points, cj);
+        double separate = 0.0;
+        for (size_t q = 0; q < both.size(); ++q) separate += std::min({others[q], ci[q], cj[q]});
         // The merged plane refitted robustly on the union from three starts (either
         // plane's homography, least squares on the union), the cheapest kept: one start
         // alone can stay with its own piece.
@@ -291,9 +344,8 @@ bool mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
           m.threshold_px = union_px;
           setPlaneNoise(m, view1, view2, in_union, energy, params);
           double cost = 0.0;
-          const double width = energy.widthCost(m);
-          for (size_t q = 0; q < both.size(); ++q)
-            cost += std::min(others[q], energy.point(m, view1[both[q]], view2[both[q]], width));
+          pointCosts(energy, m, energy.widthCost(m), both_points, cm);
+          for (size_t q = 0; q < both.size(); ++q) cost += std::min(others[q], cm[q]);
           if (cost < together) {
             together = cost;
             merged = m;
@@ -391,12 +443,14 @@ bool splitPlanes(std::vector<HomographyPlane>& planes, const std::vector<cv::Mat
     const int b = best_candidate(rest, members.size());
     if (b < 0 || !make(b, rest, B)) continue;
     double split_cost = 2.0 * energy.plane_cost, whole_cost = energy.plane_cost;
-    const double wa = energy.widthCost(A), wb = energy.widthCost(B),
-                 ww = energy.widthCost(planes[p]);
-    for (int i : members) {
-      split_cost += std::min(energy.point(A, view1[i], view2[i], wa),
-                             energy.point(B, view1[i], view2[i], wb));
-      whole_cost += energy.point(planes[p], view1[i], view2[i], ww);
+    const PointArrays member_points = arraysOf(members, view1, view2);
+    std::vector<double> ca, cb, cw;
+    pointCosts(energy, A, energy.widthCost(A), member_points, ca);
+    pointCosts(energy, B, energy.widthCost(B), member_points, cb);
+    pointCosts(energy, planes[p], energy.widthCost(planes[p]), member_points, cw);
+    for (size_t q = 0; q < members.size(); ++q) {
+      split_cost += std::min(ca[q], cb[q]);
+      whole_cost += cw[q];
     }
     if (split_cost >= whole_cost) continue;
     planes[p] = A;
@@ -421,14 +475,21 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
   const size_t n = view1.size();
   std::vector<size_t> alive(planes.size());
   std::iota(alive.begin(), alive.end(), 0);
-  std::vector<double> cost(n * planes.size(), energy.k2);
-  for (size_t k = 0; k < planes.size(); ++k) {
-    const double width = energy.widthCost(planes[k]);
-    for (size_t i = 0; i < n; ++i)
-      if (finite(view1[i]) && finite(view2[i]))
-        cost[i * planes.size() + k] = energy.point(planes[k], view1[i], view2[i], width);
-  }
+  // pointCosts a plane at a time (non-finite points cost k^2).
   const size_t stride = planes.size();
+  std::vector<double> cost(n * stride);
+  PointArrays p;
+  p.reserve(n);
+  std::vector<char> usable(n);
+  for (size_t i = 0; i < n; ++i) {
+    usable[i] = finite(view1[i]) && finite(view2[i]);
+    p.add(usable[i] ? view1[i] : cv::Point2d(), usable[i] ? view2[i] : cv::Point2d());
+  }
+  std::vector<double> row(n);
+  for (size_t k = 0; k < stride; ++k) {
+    pointCosts(energy, planes[k], energy.widthCost(planes[k]), p, row);
+    for (size_t i = 0; i < n; ++i) cost[i * stride + k] = usable[i] ? row[i] : energy.k2;
+  }
   for (;;) {
     std::vector<std::vector<int>> members(alive.size());
     std::vector<double> gain(alive.size(), -energy.plane_cost);
@@ -438,14 +499,11 @@ std::vector<std::vector<int>> keepSupportedPlanes(std::vector<HomographyPlane>& 
       double best = energy.k2, second = energy.k2;
       long label = -1;
       for (size_t k = 0; k < alive.size(); ++k) {
+        // The two least costs and the first least's plane, as selects (no branch).
         const double e = c[alive[k]];
-        if (e < best) {
-          second = best;
-          best = e;
-          label = static_cast<long>(k);
-        } else {
-          second = std::min(second, e);
-        }
+        label = e < best ? static_cast<long>(k) : label;
+        second = std::min(second, std::max(best, e));
+        best = std::min(best, e);
       }
       if (label < 0) continue;
       members[static_cast<size_t>(label)].push_back(static_cast<int>(i));
@@ -722,8 +780,12 @@ double kthResidualBelow(const cv::Matx33d& H, const std::vector<cv::Point2d>& vi
     if (below + (n - b1) <= kth) return std::numeric_limits<double>::infinity();
   }
   if (below <= kth) return std::numeric_limits<double>::infinity();
-  std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
-  return std::sqrt(r[kth]);
+  // NaN (non-finite points) has no order: nth_element's answer kept for it.
+  if (std::any_of(r.begin(), r.end(), [](double v) { return std::isnan(v); })) {
+    std::nth_element(r.begin(), r.begin() + static_cast<long>(kth), r.end());
+    return std::sqrt(r[kth]);
+  }
+  return std::sqrt(kthNonNegative(r, kth));
 }
 
 // Groups drawn as findCoplanarGroups draws them (GroupSampler, repeats skipped), each with
@@ -924,6 +986,7 @@ class RepeatedVote {
     std::stable_sort(unknown.begin(), unknown.end(),
                      [this](int a, int b) { return bound_[a] > bound_[b]; });
     PointArrays points;
+    points.reserve(order_.size());
     for (int i : order_)
       if (active[i]) points.add(view1_[i], view2_[i]);
     const double t2 = threshold_px_ * threshold_px_;

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "mono_plane_detection/planes/noise_scale.h"
@@ -85,4 +87,27 @@ TEST(TransferResiduals, AreThePixelDistances) {
   ASSERT_EQ(r.size(), 2u);
   EXPECT_NEAR(r[0], 5.0, 1e-12);
   EXPECT_NEAR(r[1], 0.0, 1e-12);
+}
+
+// The bucket sort and selection give std::sort's order and nth_element's value on squared
+// residuals: many equal values, exact zeros, tiny and huge values (beyond the buckets'
+// reach), +infinity, and sizes below and above the plain-sort cut-off.
+TEST(SortNonNegative, GivesTheSortedOrderAndTheKthValue) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> size(1, 700);
+  for (int run = 0; run < 200; ++run) {
+    std::vector<double> v = residuals(size(rng), size(rng) / 2, 0.5, run + 1);
+    for (double& r : v) r *= r;
+    if (run % 3 == 0) v.insert(v.end(), {0.0, 0.0, 1e-30, 1e12, 2.25, 2.25, 2.25});
+    if (run % 5 == 0) v.push_back(std::numeric_limits<double>::infinity());
+    std::shuffle(v.begin(), v.end(), rng);
+    std::vector<double> expected = v, sorted = v;
+    std::sort(expected.begin(), expected.end());
+    sortNonNegative(sorted);
+    ASSERT_EQ(sorted, expected) << run;
+    for (size_t k : {size_t{0}, v.size() / 10, v.size() / 2, v.size() - 1}) {
+      std::vector<double> w = v;
+      ASSERT_EQ(kthNonNegative(w, k), expected[k]) << run << " k " << k;
+    }
+  }
 }

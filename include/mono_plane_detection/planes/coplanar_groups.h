@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mono_plane_detection {
@@ -68,6 +69,7 @@ class GroupSampler {
   std::mt19937 rng_;
   std::vector<int> seeds_;
   std::vector<std::vector<int>> near_;  // per seed slot, empty until visited
+  std::vector<std::pair<double, int>> nearest_;  // neighboursOf's list, reused across seeds
   // A uniform grid of the points for the neighbour search (no cells: scan all points).
   cv::Point2d grid_origin_;
   double cell_px_ = 0.0;
