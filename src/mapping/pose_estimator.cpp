@@ -797,8 +797,8 @@ void PoseEstimator::bundleAdjust(const TrackFrame& frame,
   // landmarks 0.37 -> 0.65 deg off by the end, while their map plane kept older copies).
   // Held: humanoid target floor 2.30 -> 1.56 deg (noise seed 1), humanoid camera_height
   // 2.66 -> 1.33 deg (seed 0). Not before an up-to-scale start's floor check: its older
-  // keyframes carry the scale drift the check corrects, and held fixed they moved 3 of 8
-  // humanoid camera_height checks to a wrong floor (8-20 % off; docs/mapping.md).
+  // keyframes carry the scale drift the check corrects, and held fixed there they left
+  // the scale 6-20 % off on 1-2 of 5 humanoid camera_height runs (docs/mapping.md).
   const size_t window = static_cast<size_t>(std::max(params_.bundle_window, 3));
   const size_t kept = floor_check_ ? window : 2 * window;
   while (keyframes_.size() > kept) keyframes_.pop_front();
