@@ -217,7 +217,7 @@ class PoseEstimator {
     std::vector<std::uint64_t> ids;
     std::vector<cv::Point2d> normalized;
   };
-  std::deque<Keyframe> keyframes_;  // the newest bundle_window
+  std::deque<Keyframe> keyframes_;  // the window (newest bundle_window) and as many before it
   std::vector<double> bundle_times_ms_;
 };
 
