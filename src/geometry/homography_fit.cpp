@@ -168,8 +168,7 @@ std::optional<cv::Matx33d> fitHomography(const std::vector<cv::Point2d>& from,
     const double ax = fs * from[i].x + ftx, ay = fs * from[i].y + fty;
     const double bx = ts * to[i].x + ttx, by = ts * to[i].y + tty;
     const double w = weights.empty() ? 1.0 : weights[i];
-    const Pair m[3] = {Pair{w * ax * ax, w * ax * ay}, Pair{w * ax, w * ay * ay},
-                       Pair{w * ay, w}};
+    const Pair m[3] = {Pair{w * ax * ax, w * ax * ay}, Pair{w * ax, w * ay * ay}, Pair{w * ay, w}};
     const double f[4] = {1.0, bx, by, bx * bx + by * by};
     for (int k = 0; k < 4; ++k) {
       const Pair fk = {f[k], f[k]};
