@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -170,6 +171,23 @@ std::vector<int> inliersAmong(const cv::Matx33d& H, const std::vector<cv::Point2
   return inliers;
 }
 
+// The points of a and b, ascending, each once: a merge of the two lists when both are
+// ascending (a plane's points are; sorting the pair's points was a tenth of the merge
+// move's time at 1000 points), else a sort.
+std::vector<int> ascendingUnion(const std::vector<int>& a, const std::vector<int>& b) {
+  std::vector<int> out;
+  out.reserve(a.size() + b.size());
+  if (std::is_sorted(a.begin(), a.end()) && std::is_sorted(b.begin(), b.end())) {
+    std::merge(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+  } else {
+    out = a;
+    out.insert(out.end(), b.begin(), b.end());
+    std::sort(out.begin(), out.end());
+  }
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 // refitPlane over the points `among` (ascending), at threshold_px (instead of
 // params.vote_threshold_px: no copy of the params, whose string the moves copied per call).
 bool refitAmong(cv::Matx33d& H, std::vector<int>& inliers, const std::vector<cv::Point2d>& view1,
@@ -305,9 +323,7 @@ bool mergeSamePlanes(std::vector<HomographyPlane>& planes, const std::vector<cv:
       for (size_t j = i + 1; j < planes.size(); ++j) {
         std::vector<int> both = planes[i].inliers;
         both.insert(both.end(), planes[j].inliers.begin(), planes[j].inliers.end());
-        std::vector<int> in_union = both;  // ascending, each once
-        std::sort(in_union.begin(), in_union.end());
-        in_union.erase(std::unique(in_union.begin(), in_union.end()), in_union.end());
+        std::vector<int> in_union = ascendingUnion(planes[i].inliers, planes[j].inliers);
         const double union_px = std::max(planes[i].threshold_px, planes[j].threshold_px);
         // Every point of the two keeps its cheapest label either way (a point the merged
         // plane does not explain may go to a third plane or become an outlier).
