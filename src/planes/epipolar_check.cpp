@@ -275,7 +275,6 @@ int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& 
     merged.inliers.insert(merged.inliers.end(), planes[bj].inliers.begin(),
                           planes[bj].inliers.end());
     std::sort(merged.inliers.begin(), merged.inliers.end());
-    merged.noise_px = std::max(merged.noise_px, planes[bj].noise_px);
     criterion.measure(merged, merged.inliers);
     planes.erase(planes.begin() + static_cast<long>(bj));
     criterion.assign(planes);

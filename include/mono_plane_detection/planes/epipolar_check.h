@@ -84,8 +84,11 @@ struct PlaneCriterion {
 // point keeping its cheapest label). A piece's own scale holds what the camera model gets
 // wrong in its part of the image, so that a strip of tape on the floor, whose free
 // homography fits the lens model's error there (not plane-induced: 16-49 deg off), joins
-// the floor. Best merge first; the merged plane takes the induced homography and its
-// scale; points assigned again after each. Only planes whose induced fit pays for itself
+// the floor. Best merge first; the merged plane takes the induced homography and a scale
+// measured over the union (mostly the larger piece's). That is a deliberate trade: at one
+// scale for both the criterion would keep a strip apart (EuRoC: gains -191 and -178,
+// docs/plane_core.md), so this move puts an induced homography before the criterion's
+// optimum. Points assigned again after each. Only planes whose induced fit pays for itself
 // take part. Returns the number of merges.
 int mergeInducedPieces(std::vector<HomographyPlane>& planes, const cv::Matx33d& H1,
                        const cv::Vec3d& e2, const std::vector<cv::Point2d>& view1,
