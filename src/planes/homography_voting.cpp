@@ -962,8 +962,9 @@ NoiseScale pilotNoiseScale(const std::vector<GroupDraw::Drawn>& pilot,
 // leave, it loses only their votes, counted over those points alone (the vote after the
 // first recounted every candidate over every point left, most of them in full, since a
 // candidate of another large plane cannot be ruled out early). Candidates whose count is
-// not known are counted as voteDominant counts them, stopping once they cannot win. The
-// same winners as voteDominant with bounds.
+// not known are counted as voteDominant counts them, stopping once they cannot win or
+// the bail-out's test says they will not (so the winners are voteDominant's except, rarely,
+// a candidate as good as the best that the bail-out stopped).
 class RepeatedVote {
  public:
   RepeatedVote(const std::vector<cv::Matx33d>& candidates, const std::vector<cv::Point2d>& view1,

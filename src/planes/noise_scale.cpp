@@ -104,6 +104,7 @@ void sortNonNegative(std::vector<double>& values) {
 }
 
 double kthNonNegative(std::vector<double>& values, size_t k) {
+  if (k >= values.size()) return std::numeric_limits<double>::infinity();
   if (values.size() < 64) {
     std::nth_element(values.begin(), values.begin() + static_cast<long>(k), values.end());
     return values[k];

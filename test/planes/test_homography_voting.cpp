@@ -495,7 +495,7 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
     EXPECT_LT(floor_induced, 1.5) << "seed " << seed;  // 0.07-0.13 px
   }
   std::printf("not induced: %d planes over 20 seeds\n", not_induced);
-  EXPECT_LE(not_induced, 4);
+  EXPECT_LE(not_induced, 5);  // measured 4 (7 before the induced pieces' merge)
 }
 
 // max_planes caps the planes found, whichever move adds them (the vote, the split move):

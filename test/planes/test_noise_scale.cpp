@@ -109,5 +109,7 @@ TEST(SortNonNegative, GivesTheSortedOrderAndTheKthValue) {
       std::vector<double> w = v;
       ASSERT_EQ(kthNonNegative(w, k), expected[k]) << run << " k " << k;
     }
+    std::vector<double> w = v;  // beyond the last: no such value
+    ASSERT_EQ(kthNonNegative(w, v.size()), std::numeric_limits<double>::infinity()) << run;
   }
 }

@@ -39,14 +39,15 @@ NoiseScale medianScale(const std::vector<double>& residuals, double sigma0, doub
 NoiseScale medianScaleSquared(const std::vector<double>& squared_residuals, double sigma0,
                               double cut_sigmas, int iterations = 30);
 
-// Sorts non-negative finite doubles (squared residuals) ascending: a counting sort on
-// their bit patterns' exponent and 3 leading mantissa bits (eighths of an octave; such
+// Sorts non-negative doubles (squared residuals; +inf allowed, -0 and negatives not)
+// ascending: a counting sort on their bit patterns' exponent and 6 leading mantissa bits
+// (64 buckets per octave; such
 // doubles order as their bits do), then insertion within those buckets. The same result
 // as std::sort with few mispredicted branches: the order statistics of the noise scale's
 // estimates were a sixth of the plane core, most of it std::sort's and nth_element's
 // branches.
 void sortNonNegative(std::vector<double>& values);
-// The k-th smallest (0-based, k < size) of non-negative finite doubles, by the same
+// The k-th smallest (0-based; +inf when k >= size) of such doubles, by the same
 // buckets: the bucket holding it found by counting, only that bucket selected in. The
 // same value as std::nth_element; the order of `values` is left unspecified.
 double kthNonNegative(std::vector<double>& values, size_t k);
