@@ -392,11 +392,9 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   // Then by the score where the corner really is, as a full-resolution search would.
   if (rank) rankBy(params.block_size, corners.size());
   // goodFeaturesToTrack's quality_level is relative to the best corner it sees: in a band,
-  // the band's best; under the mask of the live points, the best unmasked one; on a
-  // coarse level, the coarse level's best. The bar of a search of the whole image, as
-  // the paper's unmasked full-resolution search has it, is set by the best corner found
-  // or live at full resolution instead (a cell's own bar does not depend on the band).
-  if (derivatives != nullptr) {
+  // the band's best. The bar of a search of the whole image is set by the best corner
+  // found or live instead (a cell's own bar does not depend on the band).
+  if (derivatives != nullptr && !band.empty()) {
     double best = 0;
     for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
     for (const auto& c : live) best = std::max(best, score(c, params.block_size));
