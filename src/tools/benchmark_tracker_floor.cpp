@@ -339,10 +339,12 @@ int main(int argc, char** argv) {
       "got a lost id back; srch = images with a search; pts = points followed per image,\n"
       "ours / the floor's; n/s = mean ms on images without / with a search, ours and floor's.\n\n",
       count, repeats, kSteadyFrom);
-  std::printf("%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s %11s\n",
-              "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
-              "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e",
-              "kept", "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
+  std::printf(
+      "%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s "
+      "%11s\n",
+      "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
+      "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept",
+      "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
   std::vector<Row> rows;
   for (const auto& [name, texture] : sources) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
@@ -358,15 +360,15 @@ int main(int argc, char** argv) {
         };
         std::printf(
             "%-9s %3dx%-3d %4d | %5.2f / %5.2f / %5.2f %5.2f %19s | %5.2f / %5.2f / %5.2f %5.2f "
-            "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d %3.0f/%-3.0f %4.2f/%-6.2f %4.2f/%-6.2f\n",
+            "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d %3.0f/%-3.0f "
+            "%4.2f/%-6.2f %4.2f/%-6.2f\n",
             name.c_str(), size.width, size.height, features, r.ours.mean, r.ours.p95, r.ours.max,
             r.ours.wall_mean, alloc(r.ours).c_str(), r.floor.mean, r.floor.p95, r.floor.max,
-            r.floor.wall_mean, alloc(r.floor).c_str(), r.ratio,
-            r.ours.p95 / r.ours.mean, r.quality.mean_error, r.quality.p95_error,
-            100 * r.quality.kept_per_image, r.quality.ids_kept, r.quality.ids_first,
-            100 * r.quality.reid_rate, r.quality.searches, r.quality.points_ours,
-            r.quality.points_floor, r.ours.plain_mean, r.ours.search_mean, r.floor.plain_mean,
-            r.floor.search_mean);
+            r.floor.wall_mean, alloc(r.floor).c_str(), r.ratio, r.ours.p95 / r.ours.mean,
+            r.quality.mean_error, r.quality.p95_error, 100 * r.quality.kept_per_image,
+            r.quality.ids_kept, r.quality.ids_first, 100 * r.quality.reid_rate, r.quality.searches,
+            r.quality.points_ours, r.quality.points_floor, r.ours.plain_mean, r.ours.search_mean,
+            r.floor.plain_mean, r.floor.search_mean);
         std::fflush(stdout);
         rows.push_back(row);
       }
