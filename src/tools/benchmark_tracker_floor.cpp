@@ -2,6 +2,7 @@
 // frames: time per image (mean, p95), heap allocations per image in the steady state
 // and tracking quality against ground truth. Writes a plot. A measurement, never a test.
 //   rosrun mono_plane_detection benchmark_tracker_floor [--frames N] [--euroc F] [--tum F]
+//     [--size WxH] [--features N]   (one row, e.g. to profile it)
 //
 // Real frames: a real image (EuRoC, TUM office) moved by known homographies. The data
 // sets hold stills (EuRoC: the vehicle stands) or images 1 s apart (TUM), neither a
@@ -76,6 +77,7 @@ struct Timing {
   // Steady state (from image kSteadyFrom on): heap allocations and kB per image, on
   // images without and with a corner search.
   double allocations = 0, kbytes = 0, search_allocations = 0, search_kbytes = 0;
+  double plain_mean = 0, search_mean = 0;  // ms, images without / with a search (all images)
 };
 
 // Per-image records of one tracker.
@@ -83,6 +85,8 @@ struct Record {
   std::vector<double> ms, wall_ms;
   long allocations[2] = {0, 0}, bytes[2] = {0, 0};  // [searched]
   int images[2] = {0, 0};
+  double split_ms[2] = {0, 0};
+  int split_images[2] = {0, 0};
 
   template <class F>
   void measure(size_t k, F&& work) {
@@ -96,6 +100,8 @@ struct Record {
     wall_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - wall).count());
     ms.push_back(threadCpuMs() - cpu);
     g_counting = false;
+    split_ms[searched] += ms.back();
+    ++split_images[searched];
     if (!steady) return;
     allocations[searched] += g_allocations;
     bytes[searched] += g_bytes;
@@ -112,6 +118,8 @@ struct Record {
     t.kbytes = bytes[0] / 1024.0 / std::max(1, images[0]);
     t.search_allocations = static_cast<double>(allocations[1]) / std::max(1, images[1]);
     t.search_kbytes = bytes[1] / 1024.0 / std::max(1, images[1]);
+    t.plain_mean = split_ms[0] / std::max(1, split_images[0]);
+    t.search_mean = split_ms[1] / std::max(1, split_images[1]);
     return t;
   }
 };
@@ -122,6 +130,8 @@ struct Quality {
   int ids_first = 0, ids_kept = 0;  // ids of the first image, and of them still there after 100
   double reid_rate = 0;  // share of new corners (after the first image) that got an old id
   int searches = 0;
+  // Points Lucas-Kanade follows per image, ours and the floor's (their work is per point).
+  double points_ours = 0, points_floor = 0;
 };
 
 struct RowResult {
@@ -138,7 +148,7 @@ RowResult runRow(const Sequence& seq, int features) {
   TrackScorer score;
   Record ours, floor;
   std::set<std::uint64_t> first;
-  double followed = 0, tracked = 0;
+  double followed = 0, tracked = 0, floor_followed = 0;
   long reidentified = 0, added = 0;
   // The floor: goodFeaturesToTrack every 10 images (or when fewer than a third are
   // left), calcOpticalFlowPyrLK from the previous image on the others; the tracker's
@@ -159,6 +169,7 @@ RowResult runRow(const Sequence& seq, int features) {
                                 params.min_distance_px, cv::noArray(), params.block_size);
         return true;
       }
+      floor_followed += static_cast<double>(points.size());
       cv::calcOpticalFlowPyrLK(seq.images[k - 1], seq.images[k], points, next, status, error,
                                cv::Size(params.window_size_px, params.window_size_px),
                                params.pyramid_levels - 1);
@@ -187,6 +198,8 @@ RowResult runRow(const Sequence& seq, int features) {
   r.quality.mean_error = score.meanError();
   r.quality.p95_error = percentile(score.errors(), 0.95);
   r.quality.kept_per_image = followed > 0 ? tracked / followed : 0;
+  r.quality.points_ours = followed / std::max<size_t>(1, seq.images.size() - 1);
+  r.quality.points_floor = floor_followed / std::max<size_t>(1, seq.images.size() - 1);
   r.quality.ids_first = static_cast<int>(first.size());
   r.quality.reid_rate = reidentified + added > 0
                             ? static_cast<double>(reidentified) / (reidentified + added)
@@ -214,6 +227,10 @@ RowResult medianRow(const Sequence& seq, int features, int repeats) {
   m.floor.p95 = median([](const RowResult& r) { return r.floor.p95; });
   m.floor.max = median([](const RowResult& r) { return r.floor.max; });
   m.floor.wall_mean = median([](const RowResult& r) { return r.floor.wall_mean; });
+  m.ours.plain_mean = median([](const RowResult& r) { return r.ours.plain_mean; });
+  m.ours.search_mean = median([](const RowResult& r) { return r.ours.search_mean; });
+  m.floor.plain_mean = median([](const RowResult& r) { return r.floor.plain_mean; });
+  m.floor.search_mean = median([](const RowResult& r) { return r.floor.search_mean; });
   m.ratio = median([](const RowResult& r) { return r.ours.mean / r.floor.mean; });
   return m;
 }
@@ -283,7 +300,8 @@ void plot(const std::vector<Row>& rows, const std::string& path) {
 int main(int argc, char** argv) {
   int count = 150, repeats = 3;
   std::string plot_path = "benchmark_tracker_floor.png";
-  std::string euroc, tum;
+  std::string euroc, tum, only_size;
+  int only_features = 0;
   cli::Parser cli("benchmark_tracker_floor", "[options]",
                   "  The tracker against goodFeaturesToTrack every 10 images +\n"
                   "  calcOpticalFlowPyrLK, on generated texture and on real images moved by\n"
@@ -292,7 +310,9 @@ int main(int argc, char** argv) {
       .integer("repeats", &repeats, 1, 100, "runs per row; figures are their median")
       .text("plot", &plot_path, "where to write the plot", "FILE.png")
       .text("euroc", &euroc, "a EuRoC image (752x480 grey) as real texture", "FILE.png")
-      .text("tum", &tum, "a TUM RGB-D image (640x480 colour) as real texture", "FILE.png");
+      .text("tum", &tum, "a TUM RGB-D image (640x480 colour) as real texture", "FILE.png")
+      .text("size", &only_size, "only the rows of this image size (profiling)", "WxH")
+      .integer("features", &only_features, 0, 100000, "only the rows of this count (0: all)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
 
@@ -316,17 +336,22 @@ int main(int argc, char** argv) {
       "(a band of) a corner search, and kB; err = px from the truth; kept = share followed\n"
       "image to image;\n"
       "ids100 = ids of image 0 still there at image 99; reid = share of new corners that\n"
-      "got a lost id back; srch = images with a search.\n\n",
+      "got a lost id back; srch = images with a search; pts = points followed per image,\n"
+      "ours / the floor's; n/s = mean ms on images without / with a search, ours and floor's.\n\n",
       count, repeats, kSteadyFrom);
-  std::printf("%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s\n",
-              "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
-              "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e",
-              "kept", "ids100", "reid", "srch");
+  std::printf(
+      "%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s "
+      "%11s\n",
+      "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
+      "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept",
+      "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
   std::vector<Row> rows;
   for (const auto& [name, texture] : sources) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
+      if (!only_size.empty() && only_size != cv::format("%dx%d", size.width, size.height)) continue;
       const Sequence seq = makeSequence(texture, size, count);
       for (int features : {50, 150, 500}) {
+        if (only_features > 0 && features != only_features) continue;
         Row row{name, size, features, medianRow(seq, features, repeats)};
         const RowResult& r = row.result;
         auto alloc = [](const Timing& t) {
@@ -335,13 +360,15 @@ int main(int argc, char** argv) {
         };
         std::printf(
             "%-9s %3dx%-3d %4d | %5.2f / %5.2f / %5.2f %5.2f %19s | %5.2f / %5.2f / %5.2f %5.2f "
-            "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d\n",
+            "%19s | %4.2fx %4.1fx | %5.3f %5.3f %4.1f%% %3d/%-3d %4.1f%% %4d %3.0f/%-3.0f "
+            "%4.2f/%-6.2f %4.2f/%-6.2f\n",
             name.c_str(), size.width, size.height, features, r.ours.mean, r.ours.p95, r.ours.max,
             r.ours.wall_mean, alloc(r.ours).c_str(), r.floor.mean, r.floor.p95, r.floor.max,
-            r.floor.wall_mean, alloc(r.floor).c_str(), r.ratio,
-            r.ours.p95 / r.ours.mean, r.quality.mean_error, r.quality.p95_error,
-            100 * r.quality.kept_per_image, r.quality.ids_kept, r.quality.ids_first,
-            100 * r.quality.reid_rate, r.quality.searches);
+            r.floor.wall_mean, alloc(r.floor).c_str(), r.ratio, r.ours.p95 / r.ours.mean,
+            r.quality.mean_error, r.quality.p95_error, 100 * r.quality.kept_per_image,
+            r.quality.ids_kept, r.quality.ids_first, 100 * r.quality.reid_rate, r.quality.searches,
+            r.quality.points_ours, r.quality.points_floor, r.ours.plain_mean, r.ours.search_mean,
+            r.floor.plain_mean, r.floor.search_mean);
         std::fflush(stdout);
         rows.push_back(row);
       }

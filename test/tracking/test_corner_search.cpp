@@ -208,6 +208,34 @@ TEST(CornerSearch, FillKeepsTheQualityBarOfTheWholeImage) {
   EXPECT_EQ(buffers.from_full_resolution, 0);
 }
 
+// The live points mask the strongest corners: the quality bar of a full-resolution
+// search is that of the whole image (quality_level x the best corner found or live), as
+// the paper's unmasked search has it, not the best unmasked corner's. Faint squares
+// (contrast 8 instead of 160: 0.25 % of the strong corners' score) beside live strong
+// ones get no corner; at contrast 40 (6 %) they do.
+TEST(CornerSearch, MaskedSearchKeepsTheQualityBarOfTheLivePoints) {
+  const Squares strong = squares({640, 240});
+  auto search = [&](double faint_gain) {
+    cv::Mat image = strong.image.clone();
+    cv::Mat right = image(cv::Rect(320, 0, 320, 240));
+    right.convertTo(right, CV_8U, faint_gain, 40 * (1 - faint_gain));
+    int levels = 0;
+    const std::vector<cv::Mat> pyramid = pyramidOf(image, &levels);
+    std::vector<cv::Point2f> live;
+    for (const auto& c : strong.corners)
+      if (c.x < 320) live.push_back(c);
+    TrackerParams params;
+    CornerSearchBuffers buffers;
+    const std::vector<cv::Point2f> found =
+        findCorners(image, image, 0, live, 100, params, buffers, &pyramid[1]);
+    for (const auto& c : found) EXPECT_LT(nearest(c, strong.corners), 0.5) << c;
+    return std::count_if(found.begin(), found.end(),
+                         [](const cv::Point2f& c) { return c.x > 320; });
+  };
+  EXPECT_EQ(search(0.05), 0);
+  EXPECT_GE(search(0.25), 20);
+}
+
 // A band of rows searches those rows only; the two halves of an image together find
 // what one search of the whole image finds (the quality bar is the best corner found or
 // live, not the band's own best).
