@@ -198,8 +198,12 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
       if (e[x] != 0.f && e[x] == d[x] && (m == nullptr || m[x] != 0))
         candidates.push_back({e[x], y * image.cols + x});
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  // goodFeaturesToTrack's order: strongest first, equal responses the later pixel first
+  // (its greaterThanPtr compares addresses; equal responses are common in flat or
+  // noise-free regions).
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.first > b.first || (a.first == b.first && a.second > b.second);
+  });
   // Spacing on a grid of min_distance cells: only the 3 x 3 cells around a corner can
   // hold one closer than min_distance.
   const double spacing = std::max(1.0, min_distance);

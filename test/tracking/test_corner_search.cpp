@@ -383,6 +383,12 @@ TEST(CornerSearch, CandidatesWithoutAFloorAreGoodFeaturesToTrack) {
   opencv.resize(20);  // at most max_corners, the strongest
   shiTomasiCandidates(image, cv::Mat(), 0.01, 0.0, 40, 10.0, 3, 20, buffers, ours, relaxed);
   EXPECT_EQ(ours, opencv);
+  // Without noise the squares' corners have equal responses: ties broken as OpenCV does.
+  const cv::Mat clean = squares({320, 240}).image;
+  cv::goodFeaturesToTrack(clean, opencv, 0, 0.01, 10.0, cv::noArray(), 3);
+  shiTomasiCandidates(clean, cv::Mat(), 0.01, 0.0, 40, 10.0, 3, 0, buffers, ours, relaxed);
+  ASSERT_GT(opencv.size(), 50u);
+  EXPECT_EQ(ours, opencv);
 }
 
 // Issue 18: a weakly textured patch beside a richly textured one (squares of 10 grey
