@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/core/eigen.hpp>
 
 #include "mono_plane_detection/geometry/stats.h"
 
@@ -26,19 +27,15 @@ struct Camera {
 Camera cameraOf(const Pose& map_from_camera) {
   const Pose c = map_from_camera.inverse();
   Camera cam;
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) cam.R(r, k) = c.R(r, k);
-    cam.t(r) = c.t[r];
-  }
+  cv::cv2eigen(c.R, cam.R);
+  cv::cv2eigen(c.t, cam.t);
   return cam;
 }
 
 Pose poseOf(const Camera& cam) {
   Pose c;
-  for (int r = 0; r < 3; ++r) {
-    for (int k = 0; k < 3; ++k) c.R(r, k) = cam.R(r, k);
-    c.t[r] = cam.t(r);
-  }
+  cv::eigen2cv(cam.R, c.R);
+  cv::eigen2cv(cam.t, c.t);
   return c.inverse();
 }
 

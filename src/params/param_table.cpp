@@ -86,7 +86,7 @@ const ParamTable<TrackerParams>& trackerParamTable() {
       {"quality_level", field(&P::quality_level), 1e-6, 0.999, "",
        "corner score threshold, fraction of the strongest corner's score"},
       {"block_size", field(&P::block_size), 1, 31, "px", "corner score neighbourhood"},
-      {"spread_grid_columns", field(&P::spread_grid_columns), 0, 1000, "",
+      {"spread_grid_columns", field(&P::spread_grid_columns), 0, 100, "",
        "new corners go first to the cells with the fewest points, on a grid of this many "
        "columns of square cells (0: strongest in the image first, the paper)"},
       {"corner_noise_margin", field(&P::corner_noise_margin), 0, 1000, "",

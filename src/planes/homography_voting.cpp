@@ -31,21 +31,10 @@ std::vector<cv::Point2d> select(const std::vector<cv::Point2d>& p, const std::ve
 
 bool finite(const cv::Point2d& p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
-// The transfer error squared, |H a - w b|^2 / w^2 (one division, no square root: the
-// weights, the criterion and the planes' scales need only its square); infinity when H
-// sends a to infinity.
-double squaredTransfer(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b) {
-  const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-  const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - b.x * w;
-  const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - b.y * w;
-  const double e2 = (dx * dx + dy * dy) / (w * w);
-  return std::abs(w) >= 1e-12 ? e2 : std::numeric_limits<double>::infinity();  // a select
-}
-
 // Cauchy weight 1 / (1 + (r / scale)^2) of a point's transfer error r (0 at infinity).
 double cauchyWeight(const cv::Matx33d& H, const cv::Point2d& a, const cv::Point2d& b,
                     double scale) {
-  const double u2 = squaredTransfer(H, a, b) / (scale * scale);
+  const double u2 = transferErrorSquaredOneDivision(H, a, b) / (scale * scale);
   return std::isfinite(u2) ? 1.0 / (1.0 + u2) : 0.0;
 }
 
@@ -234,7 +223,7 @@ struct Energy {
   // evaluate it for every point and plane, several times.
   double point(const HomographyPlane& p, const cv::Point2d& a, const cv::Point2d& b,
                double width_cost) const {
-    const double e2 = squaredTransfer(p.H, a, b);
+    const double e2 = transferErrorSquaredOneDivision(p.H, a, b);
     // As selects: every point and plane of the assignment's table, no pattern to predict.
     const double inside = std::min(e2 / (p.noise_px * p.noise_px) + width_cost, k2);
     return e2 < p.threshold_px * p.threshold_px ? inside : k2;
@@ -251,8 +240,8 @@ struct Energy {
 
 // Energy::point for every point of p (the same values), written so that it compiles to
 // vector instructions: the conditions joined by & and one select (as in votesInBlock;
-// with branches GCC keeps the loop scalar). |w| < 1e-12 is squaredTransfer's infinity,
-// a non-finite point's NaN fails e2 < t2: both cost k^2, as in Energy::point.
+// with branches GCC keeps the loop scalar). |w| < 1e-12 is transferErrorSquaredOneDivision's
+// infinity, a non-finite point's NaN fails e2 < t2: both cost k^2, as in Energy::point.
 void pointCosts(const Energy& energy, const HomographyPlane& plane, double width,
                 const PointArrays& p, std::vector<double>& out) {
   const size_t n = p.size();
@@ -294,7 +283,7 @@ void setPlaneNoise(HomographyPlane& plane, const std::vector<cv::Point2d>& view1
                    const Energy& energy, const PlaneParams& params) {
   std::vector<double> r2;  // squared residuals: the same order statistics
   r2.reserve(among.size());
-  for (int i : among) r2.push_back(squaredTransfer(plane.H, view1[i], view2[i]));
+  for (int i : among) r2.push_back(transferErrorSquaredOneDivision(plane.H, view1[i], view2[i]));
   const double sigma = energy.sigma;
   const NoiseScale s = medianScaleSquared(r2, sigma, params.noise.tail_sigmas);
   plane.noise_px = s.inliers > 0 ? std::clamp(s.sigma_px, sigma, 4.0 * sigma) : sigma;
@@ -624,9 +613,8 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   if (energy.fixed_threshold_px > 0.0) return;
   const PlaneCriterion criterion{[&](const HomographyPlane& p, const std::vector<int>& idx) {
                                    std::vector<double> c;
-                                   const double width = energy.widthCost(p);
-                                   for (int i : idx)
-                                     c.push_back(energy.point(p, view1[i], view2[i], width));
+                                   pointCosts(energy, p, energy.widthCost(p),
+                                              arraysOf(idx, view1, view2), c);
                                    return c;
                                  },
                                  [&](HomographyPlane& p, const std::vector<int>& idx) {

@@ -139,15 +139,8 @@ namespace {
 std::vector<double> squaredResiduals(const cv::Matx33d& H, const std::vector<cv::Point2d>& view1,
                                      const std::vector<cv::Point2d>& view2) {
   std::vector<double> r(view1.size());
-  for (size_t i = 0; i < view1.size(); ++i) {
-    const cv::Point2d& a = view1[i];
-    const double w = H(2, 0) * a.x + H(2, 1) * a.y + H(2, 2);
-    // |H a - w b|^2 / w^2: transferResiduals' arithmetic, squared (one division).
-    const double dx = (H(0, 0) * a.x + H(0, 1) * a.y + H(0, 2)) - view2[i].x * w;
-    const double dy = (H(1, 0) * a.x + H(1, 1) * a.y + H(1, 2)) - view2[i].y * w;
-    r[i] = std::abs(w) < 1e-12 ? std::numeric_limits<double>::infinity()
-                               : (dx * dx + dy * dy) / (w * w);
-  }
+  for (size_t i = 0; i < view1.size(); ++i)
+    r[i] = transferErrorSquaredOneDivision(H, view1[i], view2[i]);
   return r;
 }
 

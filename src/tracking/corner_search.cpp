@@ -102,7 +102,7 @@ double noiseLevel(const cv::Mat& image, double cell_px, NoiseLevelBuffers* buffe
   // |r| above the cap is texture, not noise (a median under it is exact: noise of up to
   // 60 grey levels).
   const int bins = 257;
-  b.histograms.assign(static_cast<size_t>(cols * rows * bins), 0);
+  b.histograms.assign(static_cast<size_t>(cols) * rows * bins, 0);
   b.column_cell.resize(image.cols);
   for (int x = 0; x < image.cols; ++x)
     b.column_cell[x] = std::min(cols - 1, static_cast<int>(x / cell_px)) * bins;

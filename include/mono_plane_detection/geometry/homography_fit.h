@@ -41,6 +41,19 @@ inline double transferErrorSquared(const cv::Matx33d& H, const cv::Point2d& from
   return dx * dx + dy * dy;
 }
 
+// The same squared error as |H from - w to|^2 / w^2 (one division; w the third
+// coordinate of H from): the noise scale's, the criterion's and the refits' form (its
+// last bits differ from transferErrorSquared's, and the labels were measured with each
+// where it is used); infinity when H sends the point to infinity.
+inline double transferErrorSquaredOneDivision(const cv::Matx33d& H, const cv::Point2d& from,
+                                              const cv::Point2d& to) {
+  const double w = H(2, 0) * from.x + H(2, 1) * from.y + H(2, 2);
+  const double dx = (H(0, 0) * from.x + H(0, 1) * from.y + H(0, 2)) - to.x * w;
+  const double dy = (H(1, 0) * from.x + H(1, 1) * from.y + H(1, 2)) - to.y * w;
+  const double e2 = (dx * dx + dy * dy) / (w * w);
+  return std::abs(w) >= 1e-12 ? e2 : std::numeric_limits<double>::infinity();  // a select
+}
+
 // Distance in pixels between H * from and to (the paper's vote criterion); infinity
 // when H sends the point to infinity. Inline: the vote calls it N x candidates times.
 inline double transferError(const cv::Matx33d& H, const cv::Point2d& from, const cv::Point2d& to) {
