@@ -81,7 +81,8 @@ Pose floorMapFromCamera(const cv::Vec3d& down, double camera_height_m);
 // The floor {x : up . x = offset} fitted to a map's landmarks (map frame): of the
 // planes through three of them whose normal lies within max_angle_deg of `up` (the
 // map's up as started) and that lie below every camera, the one with the most landmarks
-// within tolerance_m (each landmark's own sigma_m also counts: 3 sigma), then refined by
+// within tolerance_m (one gate for all: the landmarks' sigma_m, a pixel over their
+// parallax, overstate their noise after the bundle adjustment), then refined by
 // weighted total least squares on those (weights 1 / sigma^2) and their inliers again.
 // camera_sigma_m > 0: the cameras stay at one height (a wheeled robot), their positions
 // (noise camera_sigma_m) share the floor's normal: a floor seen as a strip ahead fixes
