@@ -105,6 +105,34 @@ Errors errorsOf(const Scene& s) {
   return e;
 }
 
+// Adds a landmark at `truth` with exact observations from every view that sees it, given
+// at `start`; returns the indices of its observations.
+std::vector<size_t> addLandmark(Scene& s, const cv::Vec3d& truth, const cv::Vec3d& start) {
+  const int j = static_cast<int>(s.problem.points.size());
+  s.truth_points.push_back(truth);
+  s.problem.points.push_back({start, false});
+  std::vector<size_t> added;
+  for (size_t i = 0; i < s.truth_views.size(); ++i) {
+    const cv::Vec3d x = s.truth_views[i].inverse().apply(truth);
+    const cv::Point2d n(x[0] / x[2], x[1] / x[2]);
+    if (x[2] < 0.05 || std::abs(n.x) > 0.64 || std::abs(n.y) > 0.48) continue;
+    added.push_back(s.problem.observations.size());
+    s.problem.observations.push_back({static_cast<int>(i), j, n});
+  }
+  return added;
+}
+
+// How many of the observations `which` have their point behind their camera now.
+int behindNow(const Scene& s, const std::vector<size_t>& which) {
+  int n = 0;
+  for (size_t k : which) {
+    const BundleObservation& o = s.problem.observations[k];
+    const Pose c = s.problem.views[o.view].map_from_camera.inverse();
+    n += c.apply(s.problem.points[o.point].position)[2] <= 0;
+  }
+  return n;
+}
+
 BundleOptions options() {
   BundleOptions o;
   o.focal_px = kFocal;
@@ -197,4 +225,81 @@ TEST(LocalBundleAdjustment, RefusesAProblemWithoutObservations) {
   EXPECT_FALSE(adjustBundle(p, options()).ok);
   p.observations.push_back({3, 0, cv::Point2d(0, 0)});  // no such view
   EXPECT_FALSE(adjustBundle(p, options()).ok);
+}
+
+
+TEST(LocalBundleAdjustment, ALandmarkGivenTooFarAlongItsRayIsNotThrownBehindItsCameras) {
+  // A close landmark (0.5 m) triangulated at twice its depth, as from two views with
+  // little parallax; its three observations exact. A step that put it behind its cameras
+  // dropped their terms from the cost, which so seemed to fall: it ended 0.065 m behind
+  // them (all three outliers) before the step had to keep it in front.
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  const cv::Vec3d truth(0.06, 0.02, 0.5);
+  const std::vector<size_t> its = addLandmark(s, truth, 2 * truth);
+  ASSERT_EQ(its.size(), 3u);
+  ASSERT_EQ(behindNow(s, its), 0);
+  const BundleResult r = adjustBundle(s.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, 0);
+  EXPECT_GT(r.refused_behind, 0);  // the case this test is for: a step tried to
+  EXPECT_EQ(r.behind_after, 0);
+  EXPECT_EQ(behindNow(s, its), 0);
+  // Brought to its place (measured 1 mm off), its observations inliers.
+  EXPECT_LT(cv::norm(s.problem.points.back().position - truth), 0.005);
+  for (size_t k : its) EXPECT_FALSE(r.outlier[k]) << r.residual_px[k];
+  // The rest as without it (ReducesPoseAndPointErrors).
+  const Errors after = errorsOf(s);
+  EXPECT_LT(after.position_m, 0.01);
+  EXPECT_LT(after.angle_deg, 0.2);
+}
+
+TEST(LocalBundleAdjustment, ALandmarkBehindItsCamerasHasNoSayAndIsFlagged) {
+  // A landmark given on the wrong side of its cameras (a two-view triangulation of
+  // near-parallel rays can land behind them): projected there it is its own mirror image,
+  // and its observations would pull the cameras toward that. They are left out: counted,
+  // flagged as outliers (infinite residual) so that the caller starts the landmark again,
+  // the landmark not moved and the rest adjusted exactly as without it.
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  Scene without = s;
+  const cv::Vec3d truth(0.3, 0.1, 1.5);
+  const cv::Vec3d start = -0.5 * truth;
+  const std::vector<size_t> its = addLandmark(s, truth, start);
+  ASSERT_GE(its.size(), 3u);
+  ASSERT_EQ(behindNow(s, its), static_cast<int>(its.size()));
+  const BundleResult r = adjustBundle(s.problem, options());
+  const BundleResult r_without = adjustBundle(without.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, static_cast<int>(its.size()));
+  EXPECT_EQ(r.behind_after, static_cast<int>(its.size()));
+  for (size_t k : its) {
+    EXPECT_TRUE(r.outlier[k]);
+    EXPECT_TRUE(std::isinf(r.residual_px[k]));
+  }
+  EXPECT_EQ(s.problem.points.back().position, start);
+  for (size_t i = 0; i < without.problem.views.size(); ++i) {
+    EXPECT_EQ(s.problem.views[i].map_from_camera.R, without.problem.views[i].map_from_camera.R);
+    EXPECT_EQ(s.problem.views[i].map_from_camera.t, without.problem.views[i].map_from_camera.t);
+  }
+  EXPECT_EQ(r.sigma_px, r_without.sigma_px);
+}
+
+TEST(LocalBundleAdjustment, ALandmarkBehindOneOfItsCamerasIsPlacedByTheOthers) {
+  // Given in front of the first views but behind the last: the views it is in front of
+  // place it (first round), then its last observations count again (second round).
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  const cv::Vec3d truth(0.5, 0.1, 0.9);
+  const std::vector<size_t> its = addLandmark(s, truth, cv::Vec3d(0.9, 0.1, 0.3));
+  ASSERT_GE(its.size(), 4u);
+  const int behind = behindNow(s, its);
+  ASSERT_GE(behind, 1);
+  ASSERT_LE(behind, static_cast<int>(its.size()) - 2);
+  const BundleResult r = adjustBundle(s.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, behind);
+  EXPECT_EQ(r.behind_after, 0);
+  EXPECT_LT(cv::norm(s.problem.points.back().position - truth), 0.005);
+  for (size_t k : its) EXPECT_FALSE(r.outlier[k]) << r.residual_px[k];
 }

@@ -56,11 +56,19 @@ struct BundleResult {
   std::vector<bool> outlier;
   // Per observation: its residual after the adjustment, px (infinite: behind the camera).
   std::vector<double> residual_px;
+  // Observations whose point is behind their camera as given, and after the adjustment.
+  // They have no say in it (a point behind projects as its mirror image); those behind
+  // after are outliers with an infinite residual: the landmark or the observation is
+  // wrong, and the caller starts the landmark again or drops the observation.
+  int behind_given = 0;
+  int behind_after = 0;
+  int refused_behind = 0;  // steps refused: they put a point behind a camera it was in front of
 };
 
 // Refines the free views and points of `problem` in place. Every free point needs two
-// observations and every free view some; a point behind a camera keeps its observation
-// out of that step. Nothing is changed when the cost does not fall.
+// observations and every free view some. An observation whose point is behind its camera
+// as a round starts is left out of that round, and no step may put a point behind a
+// camera it is in front of. Nothing is changed when the cost does not fall.
 BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options);
 
 }  // namespace mono_plane_detection
