@@ -310,22 +310,26 @@ Steps levenbergMarquardt(State& state, const std::vector<BundleObservation>& obs
   double current = *cost(state, obs, counted, focal, delta);
   double lambda = 1e-3;
   Steps steps;
+  // The equations of the current state: a refused step changes only the damping, so
+  // they are built again only after a step is taken.
+  std::optional<NormalEquations> ne;
   while (steps.tried < max_iterations) {
     ++steps.tried;
-    const NormalEquations ne = normalEquations(state, obs, counted, layout, focal, delta);
-    const ReducedSystem rs = reduceToCameras(ne, layout, obs, lambda);
+    if (!ne) ne = normalEquations(state, obs, counted, layout, focal, delta);
+    const ReducedSystem rs = reduceToCameras(*ne, layout, obs, lambda);
     Eigen::VectorXd dc = Eigen::VectorXd::Zero(rs.b.size());
     if (dc.size() > 0) dc = rs.S.ldlt().solve(rs.b);
     if (!dc.allFinite()) {
       lambda *= 10;
       continue;
     }
-    State next = applyStep(state, ne, rs, dc, layout, obs);
+    State next = applyStep(state, *ne, rs, dc, layout, obs);
     const std::optional<double> next_cost = cost(next, obs, counted, focal, delta);
     if (!next_cost) ++steps.refused_behind;
     if (next_cost && std::isfinite(*next_cost) && *next_cost < current) {
       const bool converged = current - *next_cost < 1e-6 * current;
       state = std::move(next);
+      ne.reset();
       current = *next_cost;
       lambda = std::max(1e-7, lambda / 10);
       if (converged) break;
