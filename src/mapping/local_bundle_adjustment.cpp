@@ -6,6 +6,7 @@
 #include <limits>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
+#include <string>
 
 #include "mono_plane_detection/geometry/stats.h"
 
@@ -81,12 +82,29 @@ Layout layoutOf(const BundleProblem& problem) {
   return l;
 }
 
-bool namesExist(const BundleProblem& problem) {
+bool finite(const cv::Matx33d& m) { return cv::checkRange(m); }
+bool finite(const cv::Vec3d& v) { return cv::checkRange(v); }
+
+// Why the adjustment cannot run on these; empty when it can. A NaN would reach the
+// noise's median (std::nth_element has no order with NaN) and every cost.
+std::string whyNot(const BundleProblem& problem, const BundleOptions& options) {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(options.focal_px) || !positive(options.huber_sigmas) ||
+      !positive(options.min_sigma_px) || options.max_iterations < 0)
+    return "options out of range (focal_px, huber_sigmas, min_sigma_px > 0, max_iterations >= 0)";
   const int views = static_cast<int>(problem.views.size());
   const int points = static_cast<int>(problem.points.size());
-  for (const BundleObservation& o : problem.observations)
-    if (o.view < 0 || o.view >= views || o.point < 0 || o.point >= points) return false;
-  return true;
+  for (const BundleObservation& o : problem.observations) {
+    if (o.view < 0 || o.view >= views || o.point < 0 || o.point >= points)
+      return "an observation names no view or point";
+    if (!std::isfinite(o.normalized.x) || !std::isfinite(o.normalized.y))
+      return "an observation is not finite";
+  }
+  for (const BundleView& v : problem.views)
+    if (!finite(v.map_from_camera.R) || !finite(v.map_from_camera.t)) return "a view is not finite";
+  for (const BundlePoint& p : problem.points)
+    if (!finite(p.position)) return "a point is not finite";
+  return {};
 }
 
 // The residual of one observation in pixels; false when the point is not in front.
@@ -293,6 +311,7 @@ State applyStep(const State& state, const NormalEquations& ne, const ReducedSyst
 
 struct Steps {
   int tried = 0;
+  int taken = 0;
   int refused_behind = 0;  // refused because they put a point behind a camera
 };
 
@@ -329,6 +348,7 @@ Steps levenbergMarquardt(State& state, const std::vector<BundleObservation>& obs
     if (next_cost && std::isfinite(*next_cost) && *next_cost < current) {
       const bool converged = current - *next_cost < 1e-6 * current;
       state = std::move(next);
+      ++steps.taken;
       ne.reset();
       current = *next_cost;
       lambda = std::max(1e-7, lambda / 10);
@@ -369,10 +389,8 @@ void flagOutliers(const State& state, const std::vector<BundleObservation>& obs,
 
 BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options) {
   BundleResult result;
-  if (!namesExist(problem)) {
-    result.reason = "an observation names no view or point";
-    return result;
-  }
+  result.reason = whyNot(problem, options);
+  if (!result.reason.empty()) return result;
   const double f = options.focal_px;
   const auto& obs = problem.observations;
   State state = stateOf(problem);
@@ -387,16 +405,20 @@ BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options) 
   // The Huber threshold in sigmas of the measured noise, measured again after a first
   // round: the disturbed poses' residuals overstate it (and let gross outliers pull).
   double sigma = *first_sigma;
+  int taken = 0;
   for (int round = 0; round < 2; ++round) {
     if (round > 0)
       sigma = measureSigma(state, obs, f, options.min_sigma_px).value_or(options.min_sigma_px);
     const Steps steps = levenbergMarquardt(state, obs, layout, f, options.huber_sigmas * sigma,
                                            options.max_iterations);
     result.iterations += steps.tried;
+    taken += steps.taken;
     result.refused_behind += steps.refused_behind;
   }
   const double delta = options.huber_sigmas * sigma;
-  writeBack(state, layout, problem);
+  // Untouched when no step was taken (the poses' round trip through camera_from_map
+  // would change them by rounding).
+  if (taken > 0) writeBack(state, layout, problem);
   flagOutliers(state, obs, f, delta, result);
   result.sigma_px = sigma;
   result.final_rms_px = inlierRms(state, obs, f, delta);

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "mono_plane_detection/mapping/local_bundle_adjustment.h"
@@ -131,6 +133,12 @@ int behindNow(const Scene& s, const std::vector<size_t>& which) {
     n += c.apply(s.problem.points[o.point].position)[2] <= 0;
   }
   return n;
+}
+
+// Bit for bit (NaN included).
+bool sameBits(const Pose& a, const Pose& b) {
+  return std::memcmp(a.R.val, b.R.val, sizeof a.R.val) == 0 &&
+         std::memcmp(a.t.val, b.t.val, sizeof a.t.val) == 0;
 }
 
 BundleOptions options() {
@@ -302,4 +310,54 @@ TEST(LocalBundleAdjustment, ALandmarkBehindOneOfItsCamerasIsPlacedByTheOthers) {
   EXPECT_EQ(r.behind_after, 0);
   EXPECT_LT(cv::norm(s.problem.points.back().position - truth), 0.005);
   for (size_t k : its) EXPECT_FALSE(r.outlier[k]) << r.residual_px[k];
+}
+
+TEST(LocalBundleAdjustment, RefusesNonFiniteInputAndChangesNothing) {
+  // A NaN reached the noise's median (std::nth_element: no order with NaN) and every
+  // cost: garbage thresholds and flags, reported as ok.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int where = 0; where < 4; ++where) {
+    Scene s = makeScene(6, 0.3, 3);
+    disturb(s, 2, 4);
+    if (where == 0) s.problem.observations[10].normalized.x = nan;
+    if (where == 1) s.problem.points[5].position[2] = nan;
+    if (where == 2) s.problem.views[3].map_from_camera.t[0] = nan;
+    if (where == 3) s.problem.views[4].map_from_camera.R(1, 1) = std::numeric_limits<double>::infinity();
+    const BundleProblem given = s.problem;
+    const BundleResult r = adjustBundle(s.problem, options());
+    EXPECT_FALSE(r.ok) << where;
+    EXPECT_FALSE(r.reason.empty()) << where;
+    for (size_t i = 0; i < given.views.size(); ++i)
+      EXPECT_TRUE(sameBits(s.problem.views[i].map_from_camera, given.views[i].map_from_camera))
+          << where << " view " << i;
+  }
+}
+
+TEST(LocalBundleAdjustment, ChangesNothingWithoutAStep) {
+  // Not even by rounding (the poses went through camera_from_map and back: 1e-16 off).
+  Scene s = makeScene(6, 0.3, 3);
+  disturb(s, 2, 4);
+  const BundleProblem given = s.problem;
+  BundleOptions o = options();
+  o.max_iterations = 0;
+  ASSERT_TRUE(adjustBundle(s.problem, o).ok);
+  for (size_t i = 0; i < given.views.size(); ++i)
+    EXPECT_TRUE(sameBits(s.problem.views[i].map_from_camera, given.views[i].map_from_camera)) << i;
+  for (size_t j = 0; j < given.points.size(); ++j)
+    EXPECT_EQ(s.problem.points[j].position, given.points[j].position) << j;
+}
+
+TEST(LocalBundleAdjustment, RefusesOptionsOutOfRange) {
+  Scene s = makeScene(6, 0.3, 3);
+  for (int which = 0; which < 4; ++which) {
+    BundleOptions o = options();
+    if (which == 0) o.focal_px = 0;
+    if (which == 1) o.huber_sigmas = -1;
+    if (which == 2) o.min_sigma_px = std::numeric_limits<double>::quiet_NaN();
+    if (which == 3) o.max_iterations = -1;
+    const BundleResult r = adjustBundle(s.problem, o);
+    EXPECT_FALSE(r.ok) << which;
+    EXPECT_FALSE(r.reason.empty()) << which;
+  }
+  EXPECT_TRUE(adjustBundle(s.problem, options()).ok);
 }

@@ -17,7 +17,7 @@
 namespace mono_plane_detection {
 
 struct BundleOptions {
-  int max_iterations = 10;     // Levenberg-Marquardt steps
+  int max_iterations = 10;     // Levenberg-Marquardt steps tried per round (two rounds)
   double huber_sigmas = 2.45;  // Huber threshold, in sigmas of the residual (chi2 95 %, 2 dof)
   double min_sigma_px = 0.1;   // the residuals' noise is taken as at least this
   double focal_px = 500;       // residuals in pixels: normalised error times the focal length
@@ -68,7 +68,9 @@ struct BundleResult {
 // Refines the free views and points of `problem` in place. Every free point needs two
 // observations and every free view some. An observation whose point is behind its camera
 // as a round starts is left out of that round, and no step may put a point behind a
-// camera it is in front of. Nothing is changed when the cost does not fall.
+// camera it is in front of. Nothing is changed when no step lowers the cost, nor when
+// the input is refused (!ok: a name out of range, a value not finite, options out of
+// range, fewer than 6 observations in front).
 BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options);
 
 }  // namespace mono_plane_detection
