@@ -107,12 +107,18 @@ std::string whyNot(const BundleProblem& problem, const BundleOptions& options) {
   return {};
 }
 
+Eigen::Vector3d inCamera(const State& s, const BundleObservation& o) {
+  const Camera& c = s.cameras[o.view];
+  return c.R * s.points[o.point] + c.t;
+}
+
+bool inFront(const Eigen::Vector3d& x) { return x.z() > 1e-9; }
+
 // The residual of one observation in pixels; false when the point is not in front.
 bool residual(const State& s, const BundleObservation& o, double focal, Eigen::Vector2d& r,
               Eigen::Vector3d* in_camera = nullptr) {
-  const Camera& c = s.cameras[o.view];
-  const Eigen::Vector3d x = c.R * s.points[o.point] + c.t;
-  if (!(x.z() > 1e-9)) return false;
+  const Eigen::Vector3d x = inCamera(s, o);
+  if (!inFront(x)) return false;
   r = focal * Eigen::Vector2d(x.x() / x.z() - o.normalized.x, x.y() / x.z() - o.normalized.y);
   if (in_camera) *in_camera = x;
   return true;
@@ -130,8 +136,7 @@ double huberWeight(double e, double delta) { return e <= delta ? 1.0 : delta / e
 // Per observation: its point in front of its camera.
 std::vector<bool> inFront(const State& s, const std::vector<BundleObservation>& obs) {
   std::vector<bool> in_front(obs.size());
-  Eigen::Vector2d r;
-  for (size_t k = 0; k < obs.size(); ++k) in_front[k] = residual(s, obs[k], 1, r);
+  for (size_t k = 0; k < obs.size(); ++k) in_front[k] = inFront(inCamera(s, obs[k]));
   return in_front;
 }
 

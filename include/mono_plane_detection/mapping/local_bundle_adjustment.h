@@ -48,9 +48,11 @@ struct BundleProblem {
 struct BundleResult {
   bool ok = false;
   std::string reason;         // why not, when !ok
-  int iterations = 0;         // steps taken (accepted or not)
+  int iterations = 0;         // steps tried (taken or not), both rounds
   double sigma_px = 0;        // the residuals' noise, measured after the first round
-  double initial_rms_px = 0;  // reprojection rms of the inliers before and after
+  // Reprojection rms of the inliers before (Huber threshold of the noise measured as
+  // given) and after (of the noise measured after the first round).
+  double initial_rms_px = 0;
   double final_rms_px = 0;
   // Per observation: its residual after the adjustment is beyond the Huber threshold.
   std::vector<bool> outlier;
