@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "mono_plane_detection/mapping/local_bundle_adjustment.h"
@@ -105,6 +107,40 @@ Errors errorsOf(const Scene& s) {
   return e;
 }
 
+// Adds a landmark at `truth` with exact observations from every view that sees it, given
+// at `start`; returns the indices of its observations.
+std::vector<size_t> addLandmark(Scene& s, const cv::Vec3d& truth, const cv::Vec3d& start) {
+  const int j = static_cast<int>(s.problem.points.size());
+  s.truth_points.push_back(truth);
+  s.problem.points.push_back({start, false});
+  std::vector<size_t> added;
+  for (size_t i = 0; i < s.truth_views.size(); ++i) {
+    const cv::Vec3d x = s.truth_views[i].inverse().apply(truth);
+    const cv::Point2d n(x[0] / x[2], x[1] / x[2]);
+    if (x[2] < 0.05 || std::abs(n.x) > 0.64 || std::abs(n.y) > 0.48) continue;
+    added.push_back(s.problem.observations.size());
+    s.problem.observations.push_back({static_cast<int>(i), j, n});
+  }
+  return added;
+}
+
+// How many of the observations `which` have their point behind their camera now.
+int behindNow(const Scene& s, const std::vector<size_t>& which) {
+  int n = 0;
+  for (size_t k : which) {
+    const BundleObservation& o = s.problem.observations[k];
+    const Pose c = s.problem.views[o.view].map_from_camera.inverse();
+    n += c.apply(s.problem.points[o.point].position)[2] <= 0;
+  }
+  return n;
+}
+
+// Bit for bit (NaN included).
+bool sameBits(const Pose& a, const Pose& b) {
+  return std::memcmp(a.R.val, b.R.val, sizeof a.R.val) == 0 &&
+         std::memcmp(a.t.val, b.t.val, sizeof a.t.val) == 0;
+}
+
 BundleOptions options() {
   BundleOptions o;
   o.focal_px = kFocal;
@@ -197,4 +233,131 @@ TEST(LocalBundleAdjustment, RefusesAProblemWithoutObservations) {
   EXPECT_FALSE(adjustBundle(p, options()).ok);
   p.observations.push_back({3, 0, cv::Point2d(0, 0)});  // no such view
   EXPECT_FALSE(adjustBundle(p, options()).ok);
+}
+
+
+TEST(LocalBundleAdjustment, ALandmarkGivenTooFarAlongItsRayIsNotThrownBehindItsCameras) {
+  // A close landmark (0.5 m) triangulated at twice its depth, as from two views with
+  // little parallax; its three observations exact. A step that put it behind its cameras
+  // dropped their terms from the cost, which so seemed to fall: it ended 0.065 m behind
+  // them (all three outliers) before the step had to keep it in front.
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  const cv::Vec3d truth(0.06, 0.02, 0.5);
+  const std::vector<size_t> its = addLandmark(s, truth, 2 * truth);
+  ASSERT_EQ(its.size(), 3u);
+  ASSERT_EQ(behindNow(s, its), 0);
+  const BundleResult r = adjustBundle(s.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, 0);
+  EXPECT_GT(r.refused_behind, 0);  // the case this test is for: a step tried to
+  EXPECT_EQ(r.behind_after, 0);
+  EXPECT_EQ(behindNow(s, its), 0);
+  // Brought to its place (measured 1 mm off), its observations inliers.
+  EXPECT_LT(cv::norm(s.problem.points.back().position - truth), 0.005);
+  for (size_t k : its) EXPECT_FALSE(r.outlier[k]) << r.residual_px[k];
+  // The rest as without it (ReducesPoseAndPointErrors).
+  const Errors after = errorsOf(s);
+  EXPECT_LT(after.position_m, 0.01);
+  EXPECT_LT(after.angle_deg, 0.2);
+}
+
+TEST(LocalBundleAdjustment, ALandmarkBehindItsCamerasHasNoSayAndIsFlagged) {
+  // A landmark given on the wrong side of its cameras (a two-view triangulation of
+  // near-parallel rays can land behind them): projected there it is its own mirror image,
+  // and its observations would pull the cameras toward that. They are left out: counted,
+  // flagged as outliers (infinite residual) so that the caller starts the landmark again,
+  // the landmark not moved and the rest adjusted exactly as without it.
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  Scene without = s;
+  const cv::Vec3d truth(0.3, 0.1, 1.5);
+  const cv::Vec3d start = -0.5 * truth;
+  const std::vector<size_t> its = addLandmark(s, truth, start);
+  ASSERT_GE(its.size(), 3u);
+  ASSERT_EQ(behindNow(s, its), static_cast<int>(its.size()));
+  const BundleResult r = adjustBundle(s.problem, options());
+  const BundleResult r_without = adjustBundle(without.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, static_cast<int>(its.size()));
+  EXPECT_EQ(r.behind_after, static_cast<int>(its.size()));
+  for (size_t k : its) {
+    EXPECT_TRUE(r.outlier[k]);
+    EXPECT_TRUE(std::isinf(r.residual_px[k]));
+  }
+  EXPECT_EQ(s.problem.points.back().position, start);
+  for (size_t i = 0; i < without.problem.views.size(); ++i) {
+    EXPECT_EQ(s.problem.views[i].map_from_camera.R, without.problem.views[i].map_from_camera.R);
+    EXPECT_EQ(s.problem.views[i].map_from_camera.t, without.problem.views[i].map_from_camera.t);
+  }
+  EXPECT_EQ(r.sigma_px, r_without.sigma_px);
+}
+
+TEST(LocalBundleAdjustment, ALandmarkBehindOneOfItsCamerasIsPlacedByTheOthers) {
+  // Given in front of the first views but behind the last: the views it is in front of
+  // place it (first round), then its last observations count again (second round).
+  Scene s = makeScene(8, 0.3, 1);
+  disturb(s, 2, 2);
+  const cv::Vec3d truth(0.5, 0.1, 0.9);
+  const std::vector<size_t> its = addLandmark(s, truth, cv::Vec3d(0.9, 0.1, 0.3));
+  ASSERT_GE(its.size(), 4u);
+  const int behind = behindNow(s, its);
+  ASSERT_GE(behind, 1);
+  ASSERT_LE(behind, static_cast<int>(its.size()) - 2);
+  const BundleResult r = adjustBundle(s.problem, options());
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_EQ(r.behind_given, behind);
+  EXPECT_EQ(r.behind_after, 0);
+  EXPECT_LT(cv::norm(s.problem.points.back().position - truth), 0.005);
+  for (size_t k : its) EXPECT_FALSE(r.outlier[k]) << r.residual_px[k];
+}
+
+TEST(LocalBundleAdjustment, RefusesNonFiniteInputAndChangesNothing) {
+  // A NaN reached the noise's median (std::nth_element: no order with NaN) and every
+  // cost: garbage thresholds and flags, reported as ok.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int where = 0; where < 4; ++where) {
+    Scene s = makeScene(6, 0.3, 3);
+    disturb(s, 2, 4);
+    if (where == 0) s.problem.observations[10].normalized.x = nan;
+    if (where == 1) s.problem.points[5].position[2] = nan;
+    if (where == 2) s.problem.views[3].map_from_camera.t[0] = nan;
+    if (where == 3) s.problem.views[4].map_from_camera.R(1, 1) = std::numeric_limits<double>::infinity();
+    const BundleProblem given = s.problem;
+    const BundleResult r = adjustBundle(s.problem, options());
+    EXPECT_FALSE(r.ok) << where;
+    EXPECT_FALSE(r.reason.empty()) << where;
+    for (size_t i = 0; i < given.views.size(); ++i)
+      EXPECT_TRUE(sameBits(s.problem.views[i].map_from_camera, given.views[i].map_from_camera))
+          << where << " view " << i;
+  }
+}
+
+TEST(LocalBundleAdjustment, ChangesNothingWithoutAStep) {
+  // Not even by rounding (the poses went through camera_from_map and back: 1e-16 off).
+  Scene s = makeScene(6, 0.3, 3);
+  disturb(s, 2, 4);
+  const BundleProblem given = s.problem;
+  BundleOptions o = options();
+  o.max_iterations = 0;
+  ASSERT_TRUE(adjustBundle(s.problem, o).ok);
+  for (size_t i = 0; i < given.views.size(); ++i)
+    EXPECT_TRUE(sameBits(s.problem.views[i].map_from_camera, given.views[i].map_from_camera)) << i;
+  for (size_t j = 0; j < given.points.size(); ++j)
+    EXPECT_EQ(s.problem.points[j].position, given.points[j].position) << j;
+}
+
+TEST(LocalBundleAdjustment, RefusesOptionsOutOfRange) {
+  Scene s = makeScene(6, 0.3, 3);
+  for (int which = 0; which < 4; ++which) {
+    BundleOptions o = options();
+    if (which == 0) o.focal_px = 0;
+    if (which == 1) o.huber_sigmas = -1;
+    if (which == 2) o.min_sigma_px = std::numeric_limits<double>::quiet_NaN();
+    if (which == 3) o.max_iterations = -1;
+    const BundleResult r = adjustBundle(s.problem, o);
+    EXPECT_FALSE(r.ok) << which;
+    EXPECT_FALSE(r.reason.empty()) << which;
+  }
+  EXPECT_TRUE(adjustBundle(s.problem, options()).ok);
 }
