@@ -857,6 +857,12 @@ void PoseEstimator::bundleAdjust(const TrackFrame& frame,
   BundleOptions options;
   options.focal_px = K_(0, 0);
   const BundleResult result = adjustBundle(problem, options);
+  bundle_counts_.behind_after += result.behind_after;
+  bundle_counts_.refused_behind += result.refused_behind;
+  if (!result.ok) {
+    ++bundle_counts_.refused;
+    bundle_counts_.last_reason = result.reason;
+  }
   if (result.ok) {
     for (size_t k = first_free; k < keyframes_.size(); ++k)
       keyframes_[k].map_from_camera = problem.views[k].map_from_camera;

@@ -238,8 +238,13 @@ int main(int argc, char** argv) {
       std::sort(t.begin(), t.end());
       double sum = 0;
       for (double v : t) sum += v;
-      std::printf("bundle adjustment: %zu keyframes, %.2f ms mean, %.2f ms p95, %.2f ms max\n",
-                  t.size(), sum / static_cast<double>(t.size()), t[t.size() * 95 / 100], t.back());
+      const PoseEstimator::BundleCounts& c = pipeline.poseEstimator()->bundleCounts();
+      std::printf("bundle adjustment: %zu keyframes, %.2f ms mean, %.2f ms p95, %.2f ms max; "
+                  "refused %d%s%s, observations behind a camera after %d, steps refused for "
+                  "it %d\n",
+                  t.size(), sum / static_cast<double>(t.size()), t[t.size() * 95 / 100], t.back(),
+                  c.refused, c.refused ? " (last: " : "",
+                  c.refused ? (c.last_reason + ")").c_str() : "", c.behind_after, c.refused_behind);
     }
     if (loop + 1 < loops) continue;
     // camera_height's map has its own origin and heading: the rigid motion that best

@@ -83,6 +83,10 @@ TEST(PoseEstimator, TheLocalBundleAdjustmentLessensTheDrift) {
       }
       if (params == &on) {
         EXPECT_GT(estimator.bundleTimesMs().size(), 10u);
+        // Tracks of real points in front of every camera: nothing refused or behind.
+        const PoseEstimator::BundleCounts& c = estimator.bundleCounts();
+        EXPECT_EQ(c.refused, 0) << c.last_reason;
+        EXPECT_EQ(c.behind_after, 0);
       } else {
         EXPECT_TRUE(estimator.bundleTimesMs().empty());
       }

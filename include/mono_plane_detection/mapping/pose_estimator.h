@@ -123,6 +123,14 @@ class PoseEstimator {
   void reset();
   // The local bundle adjustment's time per run, ms (the last 1000 keyframes it ran at).
   const std::vector<double>& bundleTimesMs() const { return bundle_times_ms_; }
+  // What the local bundle adjustment refused or flagged, since the start.
+  struct BundleCounts {
+    int refused = 0;             // runs that changed nothing: input refused (last_reason)
+    std::string last_reason;
+    int behind_after = 0;        // observations behind their camera after a run (outliers)
+    int refused_behind = 0;      // steps refused: they put a point behind a camera
+  };
+  const BundleCounts& bundleCounts() const { return bundle_counts_; }
 
  private:
   std::optional<PoseEstimate> visualPose(const TrackFrame& frame,
@@ -219,6 +227,7 @@ class PoseEstimator {
   };
   std::deque<Keyframe> keyframes_;  // the window (newest bundle_window) and as many before it
   std::vector<double> bundle_times_ms_;
+  BundleCounts bundle_counts_;
 };
 
 }  // namespace mono_plane_detection
