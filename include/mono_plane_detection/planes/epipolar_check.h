@@ -14,12 +14,16 @@
 namespace mono_plane_detection {
 
 // F (view 1 -> view 2: x2^T F x1 = 0) by RANSAC with the given threshold, or nothing when
-// there are fewer than 15 points or its inliers are fewer than min_inlier_share of them.
-// (A scene of one plane leaves F undetermined; then F says nothing about H.)
+// there are fewer than 15 points or its inliers (both points within the threshold of their
+// epipolar lines) are fewer than min_inlier_share of all points. (A scene of one plane
+// leaves F undetermined; then F says nothing about H.) With OpenCV 4.5 or later OpenCV's
+// USAC (USAC_FAST, its own fixed seed) on at most max_sample points, every
+// (n / max_sample)-th of the list (give it plane after plane: each keeps its share);
+// before 4.5 (Noetic's 4.2) the plain RANSAC on all points, drawing from `seed`.
 std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
                                                const std::vector<cv::Point2d>& view2,
                                                double threshold_px, double min_inlier_share = 0.3,
-                                               unsigned seed = 1);
+                                               unsigned seed = 1, size_t max_sample = 256);
 
 // Median over `probe` (view-1 points) of the distance in view 2 between H x and the
 // epipolar line F x, pixels: 0 for a plane-induced H. Infinity when no probe gives one.
