@@ -86,6 +86,44 @@ double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const c
   return std::abs(line[0] * x2.x + line[1] * x2.y + line[2]) / n;
 }
 
+namespace {
+
+// The upper median (the element at n / 2, as the check's drop rule takes it).
+double medianOf(std::vector<double>& d) {
+  std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+// The median of |N(0, 1)| and the standard error of a median of n normal values times
+// sqrt(n) (sqrt(pi / 2)).
+constexpr double kHalfNormalMedian = 0.6745;
+constexpr double kMedianError = 1.2533;
+
+}  // namespace
+
+double epipolarOffsetScore(std::vector<double> distances, double scale_px) {
+  if (distances.empty() || !(scale_px > 0.0)) return -std::numeric_limits<double>::infinity();
+  const double n = static_cast<double>(distances.size());
+  return (medianOf(distances) - kHalfNormalMedian * scale_px) * std::sqrt(n) /
+         (kMedianError * scale_px);
+}
+
+double epipolarOffsetThreshold(size_t planes) {
+  // The upper quantile of N(0, 1) at p by bisection on its tail, erfc(z / sqrt 2) / 2.
+  const double p = 0.001 / static_cast<double>(std::max<size_t>(1, planes));
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double epipolarScale(std::vector<double> distances) {
+  if (distances.empty()) return 0.0;
+  return medianOf(distances) / kHalfNormalMedian;
+}
+
 double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F) {
   const double nh = cv::norm(H), nf = cv::norm(F);
   if (nh <= 0 || nf <= 0) return 1.0;

@@ -126,6 +126,43 @@ TEST(EpipolarCheck, InlierShareCountedOverEveryPoint) {
 #endif
 }
 
+// A genuine plane's distances to its epipolar lines are |N(0, s)|: its score stays within
+// chance (one in a thousand beyond 3.09); a cluster matched 2.5 scales off its lines (a
+// period of repeated texture) scores far beyond, the fewer its points the less.
+TEST(EpipolarCheck, OffsetScoreInStandardErrorsOfTheMedian) {
+  std::mt19937 rng(21);
+  const double s = 0.2;
+  std::normal_distribution<double> g(0.0, s);
+  auto distances = [&](int n, double offset) {
+    std::vector<double> d;
+    for (int i = 0; i < n; ++i) d.push_back(std::abs(offset + g(rng)));
+    return d;
+  };
+  int beyond = 0;
+  for (int k = 0; k < 1000; ++k) beyond += epipolarOffsetScore(distances(20 + k % 200, 0.0), s) > 3.09;
+  EXPECT_LE(beyond, 5);  // the normal's median error is wider than a half-normal's: fewer
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_GT(epipolarOffsetScore(distances(17, 2.5 * s), s), 4.0);
+    EXPECT_GT(epipolarOffsetScore(distances(100, 2.5 * s), s), 10.0);
+  }
+  // The formula: median 0.6745 s scores 0; one standard error above, 1.
+  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, 0.6745 * s), s), 0.0, 1e-9);
+  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, (0.6745 + 1.2533 / 5) * s), s), 1.0, 1e-3);
+  EXPECT_TRUE(std::isinf(epipolarOffsetScore({}, s)));
+  EXPECT_TRUE(std::isinf(epipolarOffsetScore({1.0, 2.0}, 0.0)));
+  // The scale back from the distances' median.
+  EXPECT_NEAR(epipolarScale(distances(4000, 0.0)), s, 0.02 * s);
+  EXPECT_EQ(epipolarScale({}), 0.0);
+}
+
+TEST(EpipolarCheck, OffsetThresholdForSeveralPlanes) {
+  EXPECT_NEAR(epipolarOffsetThreshold(1), 3.090, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(2), 3.291, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(3), 3.403, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(0), 3.090, 0.002);
+  EXPECT_GT(epipolarOffsetThreshold(10), epipolarOffsetThreshold(5));
+}
+
 namespace {
 // The homography of the plane n.X = d (the convention of Rig::points):
 // R X + t = (R + t n^T / d) X on it.
