@@ -57,8 +57,7 @@ std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& v
     const double d1 = epipolarLineDistance(Fm.t(), view2[i], view1[i]);
     inliers += std::max(d1, d2) <= threshold_px;
   }
-  if (static_cast<double>(inliers) < min_inlier_share * static_cast<double>(n))
-    return std::nullopt;
+  if (static_cast<double>(inliers) < min_inlier_share * static_cast<double>(n)) return std::nullopt;
   return Fm;
 }
 

@@ -676,8 +676,7 @@ void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::
       std::vector<double> d = dist[p];
       std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
       off[p] = d[d.size() / 2] > vote_px;
-      const double score =
-          epipolarOffsetScore(dist[p], std::max(planes[p].noise_px, pair_scale));
+      const double score = epipolarOffsetScore(dist[p], std::max(planes[p].noise_px, pair_scale));
       if (score > worst_score) {
         worst_score = score;
         worst = p;

@@ -139,7 +139,8 @@ TEST(EpipolarCheck, OffsetScoreInStandardErrorsOfTheMedian) {
     return d;
   };
   int beyond = 0;
-  for (int k = 0; k < 1000; ++k) beyond += epipolarOffsetScore(distances(20 + k % 200, 0.0), s) > 3.09;
+  for (int k = 0; k < 1000; ++k)
+    beyond += epipolarOffsetScore(distances(20 + k % 200, 0.0), s) > 3.09;
   EXPECT_LE(beyond, 5);  // the normal's median error is wider than a half-normal's: fewer
   for (int k = 0; k < 20; ++k) {
     EXPECT_GT(epipolarOffsetScore(distances(17, 2.5 * s), s), 4.0);
@@ -147,7 +148,8 @@ TEST(EpipolarCheck, OffsetScoreInStandardErrorsOfTheMedian) {
   }
   // The formula: median 0.6745 s scores 0; one standard error above, 1.
   EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, 0.6745 * s), s), 0.0, 1e-9);
-  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, (0.6745 + 1.2533 / 5) * s), s), 1.0, 1e-3);
+  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, (0.6745 + 1.2533 / 5) * s), s), 1.0,
+              1e-3);
   EXPECT_TRUE(std::isinf(epipolarOffsetScore({}, s)));
   EXPECT_TRUE(std::isinf(epipolarOffsetScore({1.0, 2.0}, 0.0)));
   // The scale back from the distances' median.
