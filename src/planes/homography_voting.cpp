@@ -631,50 +631,70 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
 // determined (its inliers hold at least a plane's worth of points off the plane holding
 // most of them: points of one plane and a few others leave a family of F), a plane most of
 // whose points are off their epipolar lines is dropped (on EuRoC: repeated texture matched
-// one period off, consistent with a homography but not with the epipolar geometry); its
-// points go to the other planes or become outliers.
+// one period off, consistent with a homography but not with the epipolar geometry), and
+// otherwise the plane whose points are farthest off beyond chance
+// (epipolarOffsetScore above epipolarOffsetThreshold: a cluster of 17 mismatched points
+// whose median is just within the threshold); its points go to the other planes or become
+// outliers. After a drop F is estimated again without the plane (which pulled F towards
+// itself and off the others) and the planes checked again.
 void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                     const std::vector<cv::Point2d>& view2, const PlaneParams& params,
                     const Energy& energy, double vote_px, PlaneSegmentation& out) {
-  if (planes.size() < 2) return;
-  // F by RANSAC on the points of the planes only (the outliers left out: few outliers
-  // remain, so few samples are needed and a degenerate sample loses to the true F).
-  std::vector<int> on_planes;
-  for (const HomographyPlane& plane : planes)
-    on_planes.insert(on_planes.end(), plane.inliers.begin(), plane.inliers.end());
-  const std::vector<cv::Point2d> a = select(view1, on_planes), b = select(view2, on_planes);
-  const auto F = estimateFundamental(a, b, vote_px, 0.5, params.groups.seed);
-  if (!F) return;
-  // Determined: its inliers must include at least a plane's worth off the plane holding
-  // most of them (points of one plane and a few others leave a family of F).
-  std::vector<int> agree(planes.size(), 0);
-  std::vector<double> dist(view1.size(), std::numeric_limits<double>::infinity());
-  int total = 0;
-  for (size_t p = 0; p < planes.size(); ++p) {
-    for (int i : planes[p].inliers) {
-      dist[i] = epipolarLineDistance(*F, view1[i], view2[i]);
-      const bool in = dist[i] < vote_px;
-      agree[p] += in;
-      total += in;
+  std::optional<cv::Matx33d> checked;  // the last F that was determined
+  while (planes.size() >= 2) {
+    std::vector<int> on_planes;
+    for (const HomographyPlane& plane : planes)
+      on_planes.insert(on_planes.end(), plane.inliers.begin(), plane.inliers.end());
+    const std::vector<cv::Point2d> a = select(view1, on_planes), b = select(view2, on_planes);
+    const auto F = estimateFundamental(a, b, vote_px, 0.5, params.groups.seed);
+    if (!F) break;
+    // Determined: its inliers must include at least a plane's worth off the plane holding
+    // most of them (points of one plane and a few others leave a family of F).
+    std::vector<int> agree(planes.size(), 0);
+    std::vector<std::vector<double>> dist(planes.size());
+    std::vector<double> pooled;
+    int total = 0;
+    for (size_t p = 0; p < planes.size(); ++p) {
+      for (int i : planes[p].inliers) {
+        dist[p].push_back(epipolarLineDistance(*F, view1[i], view2[i]));
+        pooled.push_back(dist[p].back());
+        const bool in = dist[p].back() < vote_px;
+        agree[p] += in;
+        total += in;
+      }
     }
-  }
-  const int most = *std::max_element(agree.begin(), agree.end());
-  if (total - most < params.min_plane_support) return;
-  out.epipolar_checked = true;
-  bool dropped = false;
-  for (size_t p = planes.size(); p-- > 0;) {
-    std::vector<double> d;
-    for (int i : planes[p].inliers) d.push_back(dist[i]);
-    if (d.empty()) continue;
-    std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-    if (d[d.size() / 2] > vote_px) {
+    const int most = *std::max_element(agree.begin(), agree.end());
+    if (total - most < params.min_plane_support) break;
+    checked = F;
+    out.epipolar_checked = true;
+    const double pair_scale = epipolarScale(pooled);
+    std::vector<char> off(planes.size(), 0);
+    size_t worst = planes.size();
+    double worst_score = epipolarOffsetThreshold(planes.size());
+    for (size_t p = 0; p < planes.size(); ++p) {
+      if (dist[p].empty()) continue;
+      std::vector<double> d = dist[p];
+      std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+      off[p] = d[d.size() / 2] > vote_px;
+      const double score = epipolarOffsetScore(dist[p], std::max(planes[p].noise_px, pair_scale));
+      if (score > worst_score) {
+        worst_score = score;
+        worst = p;
+      }
+    }
+    // Those beyond the threshold all at once, else the one farthest off beyond chance.
+    if (std::find(off.begin(), off.end(), 1) == off.end()) {
+      if (worst == planes.size()) break;
+      off[worst] = 1;
+    }
+    for (size_t p = planes.size(); p-- > 0;) {
+      if (!off[p]) continue;
       planes.erase(planes.begin() + static_cast<long>(p));
       ++out.rejected_by_epipolar;
-      dropped = true;
     }
+    refineAssignment(planes, view1, view2, params, energy);
   }
-  if (dropped) refineAssignment(planes, view1, view2, params, energy);
-  replaceByInduced(planes, view1, view2, *F, vote_px, params, energy);
+  if (checked) replaceByInduced(planes, view1, view2, *checked, vote_px, params, energy);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/version.hpp>
 #include <random>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
@@ -71,6 +72,97 @@ TEST(EpipolarCheck, EstimatesFFromTwoPlanes) {
   EXPECT_LT(epipolarTransferError(rig.H({0, -1, 0}, -1.2), *F, probe), 1.5);
   // Too few points: nothing.
   EXPECT_FALSE(estimateFundamental({a.begin(), a.begin() + 10}, {b.begin(), b.begin() + 10}, 1.0));
+}
+
+// Many points, given plane after plane as the segmentation does: F comes from a stride
+// through the list (each plane keeps its share), the inlier share from every point.
+TEST(EpipolarCheck, EstimatesFFromManyPointsPlaneAfterPlane) {
+  Rig rig;
+  std::mt19937 rng(11);
+  const cv::Vec3d floor(0, -1, 0), wall = cv::normalize(cv::Vec3d(0.2, 0, -1));
+  std::vector<cv::Point2d> a, b;
+  rig.points(floor, -1.2, 700, rng, a, b);  // first, 70 % of the list
+  rig.points(wall, -3.0, 300, rng, a, b);
+  const auto F = estimateFundamental(a, b, 1.2);
+  ASSERT_TRUE(F);
+  // The wall (last 30 %) fixes F too: a sample of the list's head would leave a family of
+  // F through the floor's points, off the wall's homography by pixels.
+  const std::vector<cv::Point2d> probe{{100, 100}, {500, 80}, {320, 240}, {600, 400}, {50, 420}};
+  const double wall_px = epipolarTransferError(rig.H(wall, -3.0), *F, probe);
+  const double floor_px = epipolarTransferError(rig.H(floor, -1.2), *F, probe);
+  int near = 0;
+  for (size_t i = 0; i < a.size(); ++i) near += epipolarLineDistance(*F, a[i], b[i]) < 1.2;
+  EXPECT_LT(wall_px, 2.0);
+  EXPECT_LT(floor_px, 2.0);
+  EXPECT_GT(near, 700);
+#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5)
+  // USAC polishes F on its inliers (the fallback's RANSAC returns a 7-point F: 1.4-1.6 px,
+  // 767 points near their lines here).
+  EXPECT_LT(wall_px, 0.5);
+  EXPECT_LT(floor_px, 0.5);
+  EXPECT_GT(near, 950);
+#endif
+}
+
+TEST(EpipolarCheck, InlierShareCountedOverEveryPoint) {
+  Rig rig;
+  std::mt19937 rng(12);
+  std::vector<cv::Point2d> a, b;
+  rig.points({0, -1, 0}, -1.2, 500, rng, a, b);
+  rig.points(cv::normalize(cv::Vec3d(0.2, 0, -1)), -3.0, 500, rng, a, b);
+  // Every point but the stride's 256 made a gross mismatch (anywhere in the image): the
+  // stride alone would see only inliers.
+  std::vector<char> kept(a.size(), 0);
+  for (size_t k = 0; k < 256; ++k) kept[k * a.size() / 256] = 1;
+  std::uniform_real_distribution<double> x(0.0, 640.0), y(0.0, 480.0);
+  for (size_t i = 0; i < a.size(); ++i)
+    if (!kept[i]) b[i] = {x(rng), y(rng)};
+  // A quarter of the points on their lines: below a share of 0.3, nothing.
+  EXPECT_FALSE(estimateFundamental(a, b, 1.0, 0.3));
+#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5)
+  // (USAC on the stride; the fallback's RANSAC on all points would need more than its
+  // 1000 iterations at 74 % outliers.)
+  EXPECT_TRUE(estimateFundamental(a, b, 1.0, 0.2));
+#endif
+}
+
+// A genuine plane's distances to its epipolar lines are |N(0, s)|: its score stays within
+// chance (one in a thousand beyond 3.09); a cluster matched 2.5 scales off its lines (a
+// period of repeated texture) scores far beyond, the fewer its points the less.
+TEST(EpipolarCheck, OffsetScoreInStandardErrorsOfTheMedian) {
+  std::mt19937 rng(21);
+  const double s = 0.2;
+  std::normal_distribution<double> g(0.0, s);
+  auto distances = [&](int n, double offset) {
+    std::vector<double> d;
+    for (int i = 0; i < n; ++i) d.push_back(std::abs(offset + g(rng)));
+    return d;
+  };
+  int beyond = 0;
+  for (int k = 0; k < 1000; ++k)
+    beyond += epipolarOffsetScore(distances(20 + k % 200, 0.0), s) > 3.09;
+  EXPECT_LE(beyond, 5);  // the normal's median error is wider than a half-normal's: fewer
+  for (int k = 0; k < 20; ++k) {
+    EXPECT_GT(epipolarOffsetScore(distances(17, 2.5 * s), s), 4.0);
+    EXPECT_GT(epipolarOffsetScore(distances(100, 2.5 * s), s), 10.0);
+  }
+  // The formula: median 0.6745 s scores 0; one standard error above, 1.
+  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, 0.6745 * s), s), 0.0, 1e-9);
+  EXPECT_NEAR(epipolarOffsetScore(std::vector<double>(25, (0.6745 + 1.2533 / 5) * s), s), 1.0,
+              1e-3);
+  EXPECT_TRUE(std::isinf(epipolarOffsetScore({}, s)));
+  EXPECT_TRUE(std::isinf(epipolarOffsetScore({1.0, 2.0}, 0.0)));
+  // The scale back from the distances' median.
+  EXPECT_NEAR(epipolarScale(distances(4000, 0.0)), s, 0.02 * s);
+  EXPECT_EQ(epipolarScale({}), 0.0);
+}
+
+TEST(EpipolarCheck, OffsetThresholdForSeveralPlanes) {
+  EXPECT_NEAR(epipolarOffsetThreshold(1), 3.090, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(2), 3.291, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(3), 3.403, 0.002);
+  EXPECT_NEAR(epipolarOffsetThreshold(0), 3.090, 0.002);
+  EXPECT_GT(epipolarOffsetThreshold(10), epipolarOffsetThreshold(5));
 }
 
 namespace {

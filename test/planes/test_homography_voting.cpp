@@ -440,11 +440,14 @@ cv::Point2d apply(const cv::Matx33d& H, const cv::Point2d& p) {
 // SIFT matches undistorted by plane_pair --matches), seeds 1-20. A plane's homography is
 // plane-induced when the median over its points of the distance between its transfer and
 // the one the pose induces (n/d by least squares on H, as scripts/eval_euroc) is below
-// 1.5 px. The floor must be found and induced in every seed. Not every plane is: 4 of 45
-// here (before the merge of pieces of one 3D plane, planes/epipolar_check.h: 7 of 49;
-// 8bea236: 11 of 55): two strips of floor tape (63 and 74 points) whose merge into the
-// floor falls short, and two clusters of 17-19 mismatched points in the bottom left
-// corner, where the lens model is poorest (docs/plane_core.md, EuRoC).
+// 1.5 px. The floor must be found and induced in every seed, and so must every other
+// plane: 0 of 45 not induced (before F by USAC and the drop of planes off their
+// epipolar lines beyond chance, planes/epipolar_check.h: 4 of 47, clusters of 17-19
+// mismatched points in the bottom left corner, where the lens model is poorest, and a
+// strip of floor tape; before the merge of pieces of one 3D plane: 7 of 49; 8bea236: 11
+// of 55; docs/plane_core.md, EuRoC). Those drops must not take the genuine planes: a
+// second induced plane above the floor (40 points or more) in 19 of the 20 seeds (17
+// before).
 TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
   std::ifstream txt(std::string(TEST_DATA_DIR) + "/euroc_1403715274212143104.txt");
   const Correspondences c = readCorrespondences(txt);
@@ -458,7 +461,7 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
                       0.99989804851, 0.014089835847, -0.00034339312052, -0.014090668453,
                       0.99990066264);
   const cv::Vec3d t(-0.1100738081, 0.0003991215, -0.0008537025);
-  int not_induced = 0;
+  int not_induced = 0, with_second = 0;
   for (unsigned seed = 1; seed <= 20; ++seed) {
     PlaneParams params;
     params.groups.seed = seed;
@@ -470,6 +473,7 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
     }
     size_t floor = 0;
     double floor_induced = 1e9;
+    bool second = false;
     for (size_t k = 0; k < r.planes.size(); ++k) {
       const HomographyPlane& p = r.planes[k];
       const cv::Matx33d Hp = inducedByPose(p.H, K0, K1, R, t);
@@ -485,6 +489,7 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
       std::printf("seed %u plane %zu: %zu points, mean y %.0f, induced %.2f px\n", seed, k + 1,
                   p.inliers.size(), mean_y, induced);
       not_induced += induced >= 1.5;
+      second = second || (induced < 1.5 && mean_y < 300.0 && p.inliers.size() >= 40);
       // The floor fills the image's lower part; nothing else there is as large.
       if (mean_y > 300.0 && p.inliers.size() > floor) {
         floor = p.inliers.size();
@@ -493,9 +498,12 @@ TEST(SegmentPlanes, RealStereoPairPlaneInducedHomographies) {
     }
     EXPECT_GE(floor, 150u) << "seed " << seed;  // 204-295
     EXPECT_LT(floor_induced, 1.5) << "seed " << seed;  // 0.07-0.13 px
+    with_second += second;
   }
-  std::printf("not induced: %d planes over 20 seeds\n", not_induced);
-  EXPECT_LE(not_induced, 5);  // measured 4 (7 before the induced pieces' merge)
+  std::printf("not induced: %d planes over 20 seeds; a second plane in %d\n", not_induced,
+              with_second);
+  EXPECT_EQ(not_induced, 0);  // 4 before the drop beyond chance
+  EXPECT_GE(with_second, 18);  // measured 19 (17 before)
 }
 
 // max_planes caps the planes found, whichever move adds them (the vote, the split move):

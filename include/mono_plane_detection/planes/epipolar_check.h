@@ -14,12 +14,16 @@
 namespace mono_plane_detection {
 
 // F (view 1 -> view 2: x2^T F x1 = 0) by RANSAC with the given threshold, or nothing when
-// there are fewer than 15 points or its inliers are fewer than min_inlier_share of them.
-// (A scene of one plane leaves F undetermined; then F says nothing about H.)
+// there are fewer than 15 points or its inliers (both points within the threshold of their
+// epipolar lines) are fewer than min_inlier_share of all points. (A scene of one plane
+// leaves F undetermined; then F says nothing about H.) With OpenCV 4.5 or later OpenCV's
+// USAC (USAC_FAST, its own fixed seed) on at most max_sample points, every
+// (n / max_sample)-th of the list (give it plane after plane: each keeps its share);
+// before 4.5 (Noetic's 4.2) the plain RANSAC on all points, drawing from `seed`.
 std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
                                                const std::vector<cv::Point2d>& view2,
                                                double threshold_px, double min_inlier_share = 0.3,
-                                               unsigned seed = 1);
+                                               unsigned seed = 1, size_t max_sample = 256);
 
 // Median over `probe` (view-1 points) of the distance in view 2 between H x and the
 // epipolar line F x, pixels: 0 for a plane-induced H. Infinity when no probe gives one.
@@ -29,6 +33,25 @@ double epipolarTransferError(const cv::Matx33d& H, const cv::Matx33d& F,
 // Distance in view 2 from x2 to the epipolar line F x1, pixels (infinity when F x1 is not
 // a line).
 double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const cv::Point2d& x2);
+
+// How far beyond chance a plane's points sit from their epipolar lines, in standard
+// errors of the median: a genuine plane's distances are |N(0, s)|, median 0.674 s; the
+// median of n of them has a standard error of about 1.25 s / sqrt(n) (the normal's
+// median's; the half-normal's 0.79 s / sqrt(n) holds for Gaussian noise only, real
+// residuals have heavier tails: docs/plane_core.md, EuRoC). So
+// (median - 0.674 s) / (1.25 s / sqrt(n)); s is the larger of the plane's own noise scale
+// and epipolarScale over every plane's points (what F's own error and the calibration
+// add). A mismatched cluster of 17 points 2.5 scales off its lines scores 6; minus
+// infinity without distances or without a positive scale.
+double epipolarOffsetScore(std::vector<double> distances, double scale_px);
+
+// The score beyond which one of `planes` planes tested together is off its epipolar lines:
+// one-sided, 0.1 % for all of them at once (0.1 % / planes each, Bonferroni), as the
+// vote's bail-out's 3.09 for one: 3.29 for two planes, 3.40 for three.
+double epipolarOffsetThreshold(size_t planes);
+
+// The scale of distances to the epipolar lines, |N(0, s)|: their median / 0.674.
+double epipolarScale(std::vector<double> distances);
 
 // The algebraic form: || H^T F + F^T H || / (2 || H^T F ||) with H, F at unit norm;
 // 0 when H^T F is skew-symmetric (plane-induced), up to 1.
