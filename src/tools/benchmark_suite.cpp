@@ -116,7 +116,7 @@ struct PlaneRow {
   double our_error, nodelet_error, baseline_error;  // misclassification, %
 };
 
-PlaneRow benchPlanes(int points, int repeats) {
+PlaneRow benchPlanes(int points, int repeats, const std::string& coplanarity_test) {
   PlaneRow row{points, {}, {}, {}, 0, 0, 0};
   std::vector<double> ours, nodelet, base;
   for (int r = 0; r < repeats; ++r) {
@@ -128,6 +128,7 @@ PlaneRow benchPlanes(int points, int repeats) {
     const auto scene = makeTwoViewScene(sp);
     PlaneParams params;
     params.vote_threshold_px = 4.0 * sp.noise_px;
+    params.groups.coplanarity_test = coplanarity_test;
     double start = threadCpuMs();
     const auto result = segmentPlanes(scene.view1, scene.view2, params);
     ours.push_back(threadCpuMs() - start);
@@ -291,6 +292,7 @@ int main(int argc, char** argv) {
   bool planes_only = false;
   int only_points = 0;
   std::string plot_path = "benchmark.png";
+  std::string coplanarity_test = PlaneParams().groups.coplanarity_test;
   cli::Parser cli("benchmark_suite", "[options]",
                   "  The benchmark suite: tracker and plane segmentation, ours against\n"
                   "  baselines, with a plot. Figures, never pass/fail.");
@@ -299,7 +301,9 @@ int main(int argc, char** argv) {
       .text("plot", &plot_path, "where to write the plot", "FILE.png")
       .flag("planes-only", &planes_only, "only the plane rows (no tracker, no target search)")
       .integer("points", &only_points, 0, 100000,
-               "only the plane row of this many points (0: all)");
+               "only the plane row of this many points (0: all)")
+      .choice("coplanarity-test", &coplanarity_test, {"transfer", "cross_ratio"},
+              "the plane rows' five-point coplanarity test");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
   std::printf(
@@ -330,13 +334,15 @@ int main(int argc, char** argv) {
       "\nPlane stage (segmentPlanes) against sequential MAGSAC (cv::findHomography\n"
       "USAC_MAGSAC, remove inliers, repeat), 3 planes, 20 %% outliers, 0.7 px noise,\n"
       "threshold 2.8 px. Thread CPU ms per frame mean / p95, misclassification error:\n");
-  std::printf("  ours: core defaults (300 groups); nodelet: config/planes.yaml (100 groups)\n");
+  std::printf("  ours: core defaults (300 groups); nodelet: config/planes.yaml (100 groups); "
+              "coplanarity test %s\n",
+              coplanarity_test.c_str());
   std::printf("  %6s %15s %15s %15s %7s %7s %9s %9s %9s\n", "points", "ours", "nodelet", "baseline",
               "ratio", "ratio n", "ours err", "nod. err", "base err");
   std::vector<PlaneRow> rows;
   for (int points : {50, 200, 500, 1000}) {
     if (only_points > 0 && points != only_points) continue;
-    const PlaneRow r = benchPlanes(points, repeats);
+    const PlaneRow r = benchPlanes(points, repeats, coplanarity_test);
     rows.push_back(r);
     std::printf(
         "  %6d %6.2f / %6.2f %6.2f / %6.2f %6.2f / %6.2f %6.2fx %6.2fx %8.1f%% %8.1f%% %8.1f%%\n",
