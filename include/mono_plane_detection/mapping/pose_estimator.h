@@ -156,6 +156,22 @@ class PoseEstimator {
   // landmarks and the estimate's pose.
   void bundleAdjust(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                     PoseEstimate& estimate);
+  // Its steps (pose_estimator_window.cpp): this frame kept as a keyframe or not (true:
+  // a window of at least 3 to adjust), the window's problem, and the adjusted window
+  // written back (poses, landmarks; observations it disagrees with dropped or restarted).
+  struct WindowProblem {
+    BundleProblem problem;
+    std::vector<std::uint64_t> point_ids;  // the landmark of each problem point
+    size_t keyframe_observations = 0;      // the first ones: the keyframes' (then anchors')
+    size_t first_in_window = 0, first_free = 0;  // keyframe indices
+    std::unordered_map<double, int> keyframe_of_stamp;
+  };
+  bool addKeyframe(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
+                   const PoseEstimate& estimate);
+  size_t bundleWindow() const;
+  WindowProblem windowProblem() const;
+  void applyWindow(const WindowProblem& w, const BundleResult& result, const TrackFrame& frame,
+                   PoseEstimate& estimate);
   bool allows(MetricSource source) const;
   void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                           const Pose& map_from_camera);
