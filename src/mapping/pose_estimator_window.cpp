@@ -4,7 +4,6 @@
 // the keyframes and landmarks.
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 
 #include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
@@ -38,7 +37,7 @@ bool PoseEstimator::addKeyframe(const TrackFrame& frame, const std::vector<cv::P
   // 2.66 -> 1.33 deg (seed 0). Not before an up-to-scale start's floor check: its older
   // keyframes carry the scale drift the check corrects, and held fixed there they left
   // the scale 6-20 % off on 1-2 of 5 humanoid camera_height runs (docs/mapping.md).
-  const size_t kept = (floor_check_ && !std::getenv("MPD_HOLD")) ? bundleWindow() : 2 * bundleWindow();
+  const size_t kept = floor_check_ ? bundleWindow() : 2 * bundleWindow();
   while (keyframes_.size() > kept) keyframes_.pop_front();
   return keyframes_.size() >= 3;
 }
