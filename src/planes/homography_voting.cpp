@@ -640,7 +640,7 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
 void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::Point2d>& view1,
                     const std::vector<cv::Point2d>& view2, const PlaneParams& params,
                     const Energy& energy, double vote_px, PlaneSegmentation& out) {
-  std::optional<cv::Matx33d> checked;  // the last F that was determined
+  std::optional<cv::Matx33d> checked;  // F determined by the planes as they are now
   while (planes.size() >= 2) {
     std::vector<int> on_planes;
     for (const HomographyPlane& plane : planes)
@@ -692,6 +692,9 @@ void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::
       planes.erase(planes.begin() + static_cast<long>(p));
       ++out.rejected_by_epipolar;
     }
+    // That F held the dropped plane: the induced homographies take only an F determined
+    // by the planes left (review: none when one is left or F is no longer determined).
+    checked.reset();
     refineAssignment(planes, view1, view2, params, energy);
   }
   if (checked) replaceByInduced(planes, view1, view2, *checked, vote_px, params, energy);

@@ -334,8 +334,8 @@ int main(int argc, char** argv) {
       "\nPlane stage (segmentPlanes) against sequential MAGSAC (cv::findHomography\n"
       "USAC_MAGSAC, remove inliers, repeat), 3 planes, 20 %% outliers, 0.7 px noise,\n"
       "threshold 2.8 px. Thread CPU ms per frame mean / p95, misclassification error:\n");
-  std::printf("  ours: core defaults (300 groups); nodelet: config/planes.yaml (100 groups); "
-              "coplanarity test %s\n",
+  std::printf("  ours: core defaults (300 groups); nodelet: 100 groups as config/planes.yaml; "
+              "both with coplanarity test %s\n",
               coplanarity_test.c_str());
   std::printf("  %6s %15s %15s %15s %7s %7s %9s %9s %9s\n", "points", "ours", "nodelet", "baseline",
               "ratio", "ratio n", "ours err", "nod. err", "base err");
