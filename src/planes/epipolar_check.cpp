@@ -10,8 +10,10 @@
 #include "mono_plane_detection/geometry/triangulation.h"
 
 // OpenCV's USAC framework (findFundamentalMat with USAC_*) is there from 4.5 on; Noetic's
-// 4.2 keeps the plain RANSAC.
-#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5)
+// 4.2 keeps the plain RANSAC. -DMPD_FORCE_PLAIN_RANSAC (CMAKE_CXX_FLAGS) builds that path
+// on a newer OpenCV, to test it.
+#if !defined(MPD_FORCE_PLAIN_RANSAC) && \
+    (CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5))
 #define MPD_HAVE_USAC 1
 #else
 #define MPD_HAVE_USAC 0
@@ -45,8 +47,21 @@ std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& v
   (void)seed;
 #else
   cv::theRNG().state = seed;  // findFundamentalMat's RANSAC draws from it: repeatable
-  F = cv::findFundamentalMat(view1, view2, cv::FM_RANSAC, threshold_px, 0.999, cv::noArray());
+  std::vector<uchar> mask;
+  F = cv::findFundamentalMat(view1, view2, cv::FM_RANSAC, threshold_px, 0.999, mask);
   (void)max_sample;
+  // Plain RANSAC returns its best 7-point F: polished by least squares on its inliers
+  // (refineFundamental, at a quarter of the threshold: about the noise scale), as USAC's
+  // own final fit does, so both paths score distances against a least-squares F.
+  if (F.rows == 3 && F.cols == 3 && mask.size() == n) {
+    std::vector<cv::Point2d> a, b;
+    for (size_t i = 0; i < n; ++i)
+      if (mask[i]) {
+        a.push_back(view1[i]);
+        b.push_back(view2[i]);
+      }
+    if (const auto refined = refineFundamental(a, b, threshold_px / 4)) F = cv::Mat(*refined);
+  }
 #endif
   if (F.rows != 3 || F.cols != 3) return std::nullopt;  // none, or several solutions
   // The share over every point, by RANSAC's own test (both points near their lines).

@@ -19,7 +19,10 @@ namespace mono_plane_detection {
 // leaves F undetermined; then F says nothing about H.) With OpenCV 4.5 or later OpenCV's
 // USAC (USAC_FAST, its own fixed seed) on at most max_sample points, every
 // (n / max_sample)-th of the list (give it plane after plane: each keeps its share);
-// before 4.5 (Noetic's 4.2) the plain RANSAC on all points, drawing from `seed`.
+// before 4.5 (Noetic's 4.2; or built with -DMPD_FORCE_PLAIN_RANSAC) the plain RANSAC on
+// all points, drawing from `seed`, its F polished on its inliers (refineFundamental) as
+// USAC's is. USAC's F, and so the figures measured with it, may differ between OpenCV
+// versions (measured on 4.6).
 std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
                                                const std::vector<cv::Point2d>& view2,
                                                double threshold_px, double min_inlier_share = 0.3,
