@@ -347,6 +347,24 @@ TEST(LocalBundleAdjustment, ChangesNothingWithoutAStep) {
     EXPECT_EQ(s.problem.points[j].position, given.points[j].position) << j;
 }
 
+TEST(LocalBundleAdjustment, ChangesNothingWhenEveryStepIsRefused) {
+  // Already at the solution (exact observations, nothing disturbed): steps are tried and
+  // none lowers the cost, so the problem comes back bit for bit (review: the test above
+  // tries no step at all).
+  Scene s = makeScene(6, 0.0, 3);
+  for (size_t i = 0; i < s.problem.views.size(); ++i) s.problem.views[i].fixed = i < 2;
+  const BundleProblem given = s.problem;
+  BundleOptions o = options();
+  o.max_iterations = 10;
+  const BundleResult r = adjustBundle(s.problem, o);
+  ASSERT_TRUE(r.ok) << r.reason;
+  EXPECT_GT(r.iterations, 0);
+  for (size_t i = 0; i < given.views.size(); ++i)
+    EXPECT_TRUE(sameBits(s.problem.views[i].map_from_camera, given.views[i].map_from_camera)) << i;
+  for (size_t j = 0; j < given.points.size(); ++j)
+    EXPECT_EQ(s.problem.points[j].position, given.points[j].position) << j;
+}
+
 TEST(LocalBundleAdjustment, RefusesOptionsOutOfRange) {
   Scene s = makeScene(6, 0.3, 3);
   for (int which = 0; which < 4; ++which) {
