@@ -345,6 +345,7 @@ Steps levenbergMarquardt(State& state, const std::vector<BundleObservation>& obs
     if (dc.size() > 0) dc = rs.S.ldlt().solve(rs.b);
     if (!dc.allFinite()) {
       lambda *= 10;
+      if (lambda > 1e12) break;
       continue;
     }
     State next = applyStep(state, *ne, rs, dc, layout, obs);
@@ -360,6 +361,9 @@ Steps levenbergMarquardt(State& state, const std::vector<BundleObservation>& obs
       if (converged) break;
     } else {
       lambda *= 10;
+      // Damped this much the step is nil: no step lowers the cost (and further tens
+      // would overflow the damping to infinity; review).
+      if (lambda > 1e12) break;
     }
   }
   return steps;
