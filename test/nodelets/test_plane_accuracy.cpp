@@ -14,6 +14,7 @@
 // camera_height map (an up-to-scale start whose floor is mapped only after the turn)
 // meets the normal bound since the local bundle adjustment (worst 2.66 deg on
 // this seed; 1.25 deg since the floor's gate is one for all landmarks; docs/mapping.md).
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -70,6 +71,17 @@ TEST(PlaneAccuracy, RenderedSequence) {
         ++image_plane_messages;
         with_image_planes += !m->planes.empty();
       });
+  // Whether each nodelet has the camera, from its diagnostics (the plane nodelet's
+  // "camera model", the tracker's "camera_info").
+  bool plane_has_camera = false, tracker_has_camera = false;
+  ros::Subscriber diagnostics_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
+        for (const auto& status : m->status)
+          for (const auto& kv : status.values) {
+            if (kv.key == "camera model" && kv.value != "none") plane_has_camera = true;
+            if (kv.key == "camera_info" && kv.value == "ok") tracker_has_camera = true;
+          }
+      });
   tf2_ros::TransformBroadcaster odometry;
   spinUntil(
       [&] {
@@ -93,11 +105,15 @@ TEST(PlaneAccuracy, RenderedSequence) {
   for (const rosbag::MessageInstance& m : view) {
     if (auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
       info_pub.publish(info);
-      // The first camera on its own, before any image: camera_info and tracks come on
-      // separate connections, so the first image's tracks could reach the plane nodelet
-      // before it (a different start: 174 instead of 182 images placed, once too few
-      // under load); the rest are ordered by the lock-step below.
-      if (images == 0) ros::Duration(1.0).sleep();
+      // The first camera on its own, until both nodelets say they have it: camera_info
+      // and tracks come on separate connections, so the first image's tracks could
+      // reach the plane nodelet before it (a different start: 174 instead of 182 images
+      // placed, once too few under load); the rest are ordered by the lock-step below.
+      if (images == 0) {
+        spinUntil([&] { return plane_has_camera && tracker_has_camera; }, 30.0);
+        ASSERT_TRUE(plane_has_camera && tracker_has_camera)
+            << "the nodelets never reported the camera in their diagnostics";
+      }
       continue;
     }
     auto image = m.instantiate<sensor_msgs::Image>();
