@@ -2,10 +2,12 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "mono_plane_detection/geometry/opencv_usac.h"
+
 namespace mono_plane_detection {
 
 namespace {
-#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5)
+#if MPD_HAVE_USAC
 constexpr int kMethod = cv::USAC_MAGSAC;
 #else
 constexpr int kMethod = cv::RANSAC;

@@ -4,20 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/core/version.hpp>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/opencv_usac.h"
 #include "mono_plane_detection/geometry/triangulation.h"
-
-// OpenCV's USAC framework (findFundamentalMat with USAC_*) is there from 4.5 on; Noetic's
-// 4.2 keeps the plain RANSAC. -DMPD_FORCE_PLAIN_RANSAC (CMAKE_CXX_FLAGS) builds that path
-// on a newer OpenCV, to test it.
-#if !defined(MPD_FORCE_PLAIN_RANSAC) && \
-    (CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5))
-#define MPD_HAVE_USAC 1
-#else
-#define MPD_HAVE_USAC 0
-#endif
 
 namespace mono_plane_detection {
 

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "mono_plane_detection/geometry/homography_fit.h"
+#include "mono_plane_detection/geometry/opencv_usac.h"
 #include "mono_plane_detection/planes/epipolar_check.h"
 
 using namespace mono_plane_detection;
@@ -118,8 +119,7 @@ TEST(EpipolarCheck, InlierShareCountedOverEveryPoint) {
     if (!kept[i]) b[i] = {x(rng), y(rng)};
   // A quarter of the points on their lines: below a share of 0.3, nothing.
   EXPECT_FALSE(estimateFundamental(a, b, 1.0, 0.3));
-#if !defined(MPD_FORCE_PLAIN_RANSAC) && \
-    (CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 5))
+#if MPD_HAVE_USAC
   // (USAC on the stride; the fallback's RANSAC on all points would need more than its
   // 1000 iterations at 74 % outliers.)
   EXPECT_TRUE(estimateFundamental(a, b, 1.0, 0.2));

@@ -16,13 +16,13 @@ namespace mono_plane_detection {
 // F (view 1 -> view 2: x2^T F x1 = 0) by RANSAC with the given threshold, or nothing when
 // there are fewer than 15 points or its inliers (both points within the threshold of their
 // epipolar lines) are fewer than min_inlier_share of all points. (A scene of one plane
-// leaves F undetermined; then F says nothing about H.) With OpenCV 4.5 or later OpenCV's
-// USAC (USAC_FAST, its own fixed seed) on at most max_sample points, every
-// (n / max_sample)-th of the list (give it plane after plane: each keeps its share);
-// before 4.5 (Noetic's 4.2; or built with -DMPD_FORCE_PLAIN_RANSAC) the plain RANSAC on
-// all points, drawing from `seed`, its F polished on its inliers (refineFundamental) as
-// USAC's is. USAC's F, and so the figures measured with it, may differ between OpenCV
-// versions (measured on 4.6).
+// leaves F undetermined; then F says nothing about H.) With OpenCV 4.5.2 or later
+// (geometry/opencv_usac.h) OpenCV's USAC (USAC_FAST, its own fixed seed) on at most
+// max_sample points, every (n / max_sample)-th of the list (give it plane after plane:
+// each keeps its share); before (Noetic's 4.2; or built with -DMPD_FORCE_PLAIN_RANSAC)
+// the plain RANSAC on all points, drawing from `seed`, its F polished on its inliers
+// (refineFundamental) as USAC's is. USAC's F, and so the figures measured with it, may
+// differ between OpenCV versions (measured on 4.6).
 std::optional<cv::Matx33d> estimateFundamental(const std::vector<cv::Point2d>& view1,
                                                const std::vector<cv::Point2d>& view2,
                                                double threshold_px, double min_inlier_share = 0.3,
