@@ -125,7 +125,7 @@ class PoseEstimator {
   const std::vector<double>& bundleTimesMs() const { return bundle_times_ms_; }
   // What the local bundle adjustment refused or flagged, since the start.
   struct BundleCounts {
-    int refused = 0;             // runs that changed nothing: input refused (last_reason)
+    int refused = 0;             // runs whose input was refused (last_reason)
     std::string last_reason;
     int behind_after = 0;        // observations behind their camera after a run (outliers)
     int refused_behind = 0;      // steps refused: they put a point behind a camera
