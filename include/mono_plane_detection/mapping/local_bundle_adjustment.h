@@ -71,9 +71,9 @@ struct BundleResult {
 // two observations (with one it only slides along its ray under the damping: the caller
 // holds such points fixed) and every free view some. An observation whose point is
 // behind its camera as a round starts is left out of that round, and no step may put a
-// point behind a camera it is in front of. Nothing is changed when no step lowers the cost, nor when
-// the input is refused (!ok: a name out of range, a value not finite, options out of
-// range, fewer than 6 observations in front).
+// point behind a camera it is in front of. Nothing is changed when no step lowers the
+// cost, nor when the input is refused (!ok: a name out of range, a value not finite,
+// options out of range, fewer than 6 observations in front).
 BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options);
 
 }  // namespace mono_plane_detection
