@@ -41,6 +41,12 @@ struct Rig {
       b.emplace_back(x2[0] / x2[2] + g(rng), x2[1] / x2[2] + g(rng));
     }
   }
+  // `each` points on the floor 1.2 m below, then as many on a wall 3 m ahead.
+  void floorAndWall(int each, std::mt19937& rng, std::vector<cv::Point2d>& a,
+                    std::vector<cv::Point2d>& b) const {
+    points({0, -1, 0}, -1.2, each, rng, a, b);
+    points(cv::normalize(cv::Vec3d(0.2, 0, -1)), -3.0, each, rng, a, b);
+  }
 };
 
 }  // namespace
@@ -64,8 +70,7 @@ TEST(EpipolarCheck, EstimatesFFromTwoPlanes) {
   Rig rig;
   std::mt19937 rng(4);
   std::vector<cv::Point2d> a, b;
-  rig.points({0, -1, 0}, -1.2, 80, rng, a, b);
-  rig.points(cv::normalize(cv::Vec3d(0.2, 0, -1)), -3.0, 80, rng, a, b);
+  rig.floorAndWall(80, rng, a, b);
   const auto F = estimateFundamental(a, b, 1.0);
   ASSERT_TRUE(F);
   // The true plane homography is compatible with the estimate within about a pixel.
@@ -108,8 +113,7 @@ TEST(EpipolarCheck, InlierShareCountedOverEveryPoint) {
   Rig rig;
   std::mt19937 rng(12);
   std::vector<cv::Point2d> a, b;
-  rig.points({0, -1, 0}, -1.2, 500, rng, a, b);
-  rig.points(cv::normalize(cv::Vec3d(0.2, 0, -1)), -3.0, 500, rng, a, b);
+  rig.floorAndWall(500, rng, a, b);
   // Every point but the stride's 256 made a gross mismatch (anywhere in the image): the
   // stride alone would see only inliers.
   std::vector<char> kept(a.size(), 0);
