@@ -98,8 +98,9 @@ double medianOf(std::vector<double>& d) {
   return d[d.size() / 2];
 }
 
-// The median of |N(0, 1)| and the standard error of a median of n normal values times
-// sqrt(n) (sqrt(pi / 2)).
+// The median of |N(0, 1)|, and the standard error of the median of n such values times
+// sqrt(n), widened: 0.787 under the normal model, 1.2533 (sqrt(pi / 2), 1.59 times) for
+// the heavier tails of real residuals (epipolar_check.h, docs/plane_core.md item 7).
 constexpr double kHalfNormalMedian = 0.6745;
 constexpr double kMedianError = 1.2533;
 
