@@ -624,6 +624,40 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   mergeInducedPieces(planes, A, e, view1, view2, criterion);
 }
 
+// Whether plane `tested` is still beyond chance against an F estimated from the other
+// planes' points (and their epipolar scale) when those determine one on their own; true
+// when they do not (then the F of all planes is the only evidence).
+bool offAgainstTheOthers(const std::vector<HomographyPlane>& planes, size_t tested,
+                         const std::vector<cv::Point2d>& view1,
+                         const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                         double vote_px) {
+  std::vector<int> others;
+  for (size_t p = 0; p < planes.size(); ++p)
+    if (p != tested) others.insert(others.end(), planes[p].inliers.begin(), planes[p].inliers.end());
+  const auto F = estimateFundamental(select(view1, others), select(view2, others), vote_px, 0.5,
+                                     params.groups.seed);
+  if (!F) return true;
+  std::vector<int> agree;
+  std::vector<double> pooled;
+  int total = 0;
+  for (size_t p = 0; p < planes.size(); ++p) {
+    if (p == tested) continue;
+    int in = 0;
+    for (int i : planes[p].inliers) {
+      pooled.push_back(epipolarLineDistance(*F, view1[i], view2[i]));
+      in += pooled.back() < vote_px;
+    }
+    agree.push_back(in);
+    total += in;
+  }
+  const int most = agree.empty() ? 0 : *std::max_element(agree.begin(), agree.end());
+  if (total - most < params.min_plane_support) return true;
+  std::vector<double> d;
+  for (int i : planes[tested].inliers) d.push_back(epipolarLineDistance(*F, view1[i], view2[i]));
+  const double scale = std::max(planes[tested].noise_px, epipolarScale(pooled));
+  return epipolarOffsetScore(d, scale) > epipolarOffsetThreshold(planes.size());
+}
+
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
 // homography a plane induces lie on their epipolar lines. F by RANSAC on the points of
 // the planes found (the outliers left out: few samples are needed and a degenerate sample,
@@ -682,9 +716,13 @@ void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::
         worst = p;
       }
     }
-    // Those beyond the threshold all at once, else the one farthest off beyond chance.
+    // Those beyond the threshold all at once, else the one farthest off beyond chance,
+    // confirmed against an F of the other planes when they determine one (the F above
+    // holds the tested plane too: it may have pulled F, and its own distances the pooled
+    // scale, towards itself; review).
     if (std::find(off.begin(), off.end(), 1) == off.end()) {
       if (worst == planes.size()) break;
+      if (!offAgainstTheOthers(planes, worst, view1, view2, params, vote_px)) break;
       off[worst] = 1;
     }
     for (size_t p = planes.size(); p-- > 0;) {
