@@ -343,14 +343,13 @@ Steps levenbergMarquardt(State& state, const std::vector<BundleObservation>& obs
     const ReducedSystem rs = reduceToCameras(*ne, layout, obs, lambda);
     Eigen::VectorXd dc = Eigen::VectorXd::Zero(rs.b.size());
     if (dc.size() > 0) dc = rs.S.ldlt().solve(rs.b);
-    if (!dc.allFinite()) {
-      lambda *= 10;
-      if (lambda > 1e12) break;
-      continue;
+    State next;
+    std::optional<double> next_cost;
+    if (dc.allFinite()) {
+      next = applyStep(state, *ne, rs, dc, layout, obs);
+      next_cost = cost(next, obs, counted, focal, delta);
+      if (!next_cost) ++steps.refused_behind;
     }
-    State next = applyStep(state, *ne, rs, dc, layout, obs);
-    const std::optional<double> next_cost = cost(next, obs, counted, focal, delta);
-    if (!next_cost) ++steps.refused_behind;
     if (next_cost && std::isfinite(*next_cost) && *next_cost < current) {
       const bool converged = current - *next_cost < 1e-6 * current;
       state = std::move(next);
@@ -430,7 +429,15 @@ BundleResult adjustBundle(BundleProblem& problem, const BundleOptions& options) 
   if (taken > 0) writeBack(state, layout, problem);
   flagOutliers(state, obs, f, delta, result);
   result.sigma_px = sigma;
-  result.final_rms_px = inlierRms(state, obs, f, delta);
+  // The rms of the residuals within the threshold, those flagOutliers measured.
+  double sum = 0;
+  int inliers = 0;
+  for (size_t k = 0; k < obs.size(); ++k)
+    if (!result.outlier[k]) {
+      sum += result.residual_px[k] * result.residual_px[k];
+      ++inliers;
+    }
+  result.final_rms_px = inliers > 0 ? std::sqrt(sum / inliers) : 0;
   result.ok = true;
   return result;
 }

@@ -7,6 +7,7 @@
 
 #include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/geometry/opencv_usac.h"
+#include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/geometry/triangulation.h"
 
 namespace mono_plane_detection {
@@ -92,12 +93,6 @@ double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const c
 
 namespace {
 
-// The upper median (the element at n / 2, as the check's drop rule takes it).
-double medianOf(std::vector<double>& d) {
-  std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
-  return d[d.size() / 2];
-}
-
 // The median of |N(0, 1)|, and the standard error of the median of n such values times
 // sqrt(n), widened: 0.787 under the normal model, 1.2533 (sqrt(pi / 2), 1.59 times) for
 // the heavier tails of real residuals (epipolar_check.h, docs/plane_core.md item 7).
@@ -106,10 +101,10 @@ constexpr double kMedianError = 1.2533;
 
 }  // namespace
 
-double epipolarOffsetScore(std::vector<double> distances, double scale_px) {
+double epipolarOffsetScore(const std::vector<double>& distances, double scale_px) {
   if (distances.empty() || !(scale_px > 0.0)) return -std::numeric_limits<double>::infinity();
   const double n = static_cast<double>(distances.size());
-  return (medianOf(distances) - kHalfNormalMedian * scale_px) * std::sqrt(n) /
+  return (median(distances) - kHalfNormalMedian * scale_px) * std::sqrt(n) /
          (kMedianError * scale_px);
 }
 
@@ -124,9 +119,9 @@ double epipolarOffsetThreshold(size_t planes) {
   return 0.5 * (lo + hi);
 }
 
-double epipolarScale(std::vector<double> distances) {
+double epipolarScale(const std::vector<double>& distances) {
   if (distances.empty()) return 0.0;
-  return medianOf(distances) / kHalfNormalMedian;
+  return median(distances) / kHalfNormalMedian;
 }
 
 double skewSymmetryError(const cv::Matx33d& H, const cv::Matx33d& F) {

@@ -15,6 +15,7 @@
 
 #include "mono_plane_detection/geometry/homography_fit.h"
 #include "mono_plane_detection/geometry/homography_four.h"
+#include "mono_plane_detection/geometry/stats.h"
 #include "mono_plane_detection/planes/epipolar_check.h"
 
 namespace mono_plane_detection {
@@ -624,38 +625,57 @@ void replaceByInduced(std::vector<HomographyPlane>& planes, const std::vector<cv
   mergeInducedPieces(planes, A, e, view1, view2, criterion);
 }
 
-// Whether plane `tested` is still beyond chance against an F estimated from the other
-// planes' points (and their epipolar scale) when those determine one on their own; true
-// when they do not (then the F of all planes is the only evidence).
+// F from the points of the planes (all but `skip`), when they determine it: its inliers
+// hold at least a plane's worth off the plane holding most of them (points of one plane
+// and a few others leave a family of F). Every plane's distances to its epipolar lines
+// under it (the skipped one's too), and those of the planes it was fitted to, pooled.
+struct PlanesF {
+  std::optional<cv::Matx33d> F;            // nothing: not estimated or not determined
+  std::vector<std::vector<double>> dist;   // per plane
+  std::vector<double> pooled;              // of the planes F was fitted to
+};
+
+PlanesF fundamentalOfPlanes(const std::vector<HomographyPlane>& planes,
+                            const std::vector<cv::Point2d>& view1,
+                            const std::vector<cv::Point2d>& view2, const PlaneParams& params,
+                            double vote_px, size_t skip = std::numeric_limits<size_t>::max()) {
+  PlanesF out;
+  std::vector<int> on_planes;
+  for (size_t p = 0; p < planes.size(); ++p)
+    if (p != skip)
+      on_planes.insert(on_planes.end(), planes[p].inliers.begin(), planes[p].inliers.end());
+  const auto F = estimateFundamental(select(view1, on_planes), select(view2, on_planes), vote_px,
+                                     0.5, params.groups.seed);
+  if (!F) return out;
+  out.dist.resize(planes.size());
+  int total = 0, most = 0;
+  for (size_t p = 0; p < planes.size(); ++p) {
+    int agree = 0;
+    for (int i : planes[p].inliers) {
+      out.dist[p].push_back(epipolarLineDistance(*F, view1[i], view2[i]));
+      agree += out.dist[p].back() < vote_px;
+    }
+    if (p == skip) continue;
+    out.pooled.insert(out.pooled.end(), out.dist[p].begin(), out.dist[p].end());
+    total += agree;
+    most = std::max(most, agree);
+  }
+  if (total - most >= params.min_plane_support) out.F = F;
+  return out;
+}
+
+// Whether plane `tested` is still beyond chance against the F of the other planes and
+// their epipolar scale, when those determine one on their own; true when they do not
+// (then the F of all planes is the only evidence).
 bool offAgainstTheOthers(const std::vector<HomographyPlane>& planes, size_t tested,
                          const std::vector<cv::Point2d>& view1,
                          const std::vector<cv::Point2d>& view2, const PlaneParams& params,
                          double vote_px) {
-  std::vector<int> others;
-  for (size_t p = 0; p < planes.size(); ++p)
-    if (p != tested) others.insert(others.end(), planes[p].inliers.begin(), planes[p].inliers.end());
-  const auto F = estimateFundamental(select(view1, others), select(view2, others), vote_px, 0.5,
-                                     params.groups.seed);
-  if (!F) return true;
-  std::vector<int> agree;
-  std::vector<double> pooled;
-  int total = 0;
-  for (size_t p = 0; p < planes.size(); ++p) {
-    if (p == tested) continue;
-    int in = 0;
-    for (int i : planes[p].inliers) {
-      pooled.push_back(epipolarLineDistance(*F, view1[i], view2[i]));
-      in += pooled.back() < vote_px;
-    }
-    agree.push_back(in);
-    total += in;
-  }
-  const int most = agree.empty() ? 0 : *std::max_element(agree.begin(), agree.end());
-  if (total - most < params.min_plane_support) return true;
-  std::vector<double> d;
-  for (int i : planes[tested].inliers) d.push_back(epipolarLineDistance(*F, view1[i], view2[i]));
-  const double scale = std::max(planes[tested].noise_px, epipolarScale(pooled));
-  return epipolarOffsetScore(d, scale) > epipolarOffsetThreshold(planes.size());
+  const PlanesF others = fundamentalOfPlanes(planes, view1, view2, params, vote_px, tested);
+  if (!others.F) return true;
+  const double scale = std::max(planes[tested].noise_px, epipolarScale(others.pooled));
+  return epipolarOffsetScore(others.dist[tested], scale) >
+         epipolarOffsetThreshold(planes.size());
 }
 
 // Only plane-induced homographies (planes/epipolar_check.h): the points of a plane whose
@@ -676,41 +696,19 @@ void dropNonInduced(std::vector<HomographyPlane>& planes, const std::vector<cv::
                     const Energy& energy, double vote_px, PlaneSegmentation& out) {
   std::optional<cv::Matx33d> checked;  // F determined by the planes as they are now
   while (planes.size() >= 2) {
-    std::vector<int> on_planes;
-    for (const HomographyPlane& plane : planes)
-      on_planes.insert(on_planes.end(), plane.inliers.begin(), plane.inliers.end());
-    const std::vector<cv::Point2d> a = select(view1, on_planes), b = select(view2, on_planes);
-    const auto F = estimateFundamental(a, b, vote_px, 0.5, params.groups.seed);
-    if (!F) break;
-    // Determined: its inliers must include at least a plane's worth off the plane holding
-    // most of them (points of one plane and a few others leave a family of F).
-    std::vector<int> agree(planes.size(), 0);
-    std::vector<std::vector<double>> dist(planes.size());
-    std::vector<double> pooled;
-    int total = 0;
-    for (size_t p = 0; p < planes.size(); ++p) {
-      for (int i : planes[p].inliers) {
-        dist[p].push_back(epipolarLineDistance(*F, view1[i], view2[i]));
-        pooled.push_back(dist[p].back());
-        const bool in = dist[p].back() < vote_px;
-        agree[p] += in;
-        total += in;
-      }
-    }
-    const int most = *std::max_element(agree.begin(), agree.end());
-    if (total - most < params.min_plane_support) break;
-    checked = F;
+    const PlanesF all = fundamentalOfPlanes(planes, view1, view2, params, vote_px);
+    if (!all.F) break;
+    checked = all.F;
     out.epipolar_checked = true;
-    const double pair_scale = epipolarScale(pooled);
+    const double pair_scale = epipolarScale(all.pooled);
     std::vector<char> off(planes.size(), 0);
     size_t worst = planes.size();
     double worst_score = epipolarOffsetThreshold(planes.size());
     for (size_t p = 0; p < planes.size(); ++p) {
-      if (dist[p].empty()) continue;
-      std::vector<double> d = dist[p];
-      std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-      off[p] = d[d.size() / 2] > vote_px;
-      const double score = epipolarOffsetScore(dist[p], std::max(planes[p].noise_px, pair_scale));
+      if (all.dist[p].empty()) continue;
+      off[p] = median(all.dist[p]) > vote_px;
+      const double score =
+          epipolarOffsetScore(all.dist[p], std::max(planes[p].noise_px, pair_scale));
       if (score > worst_score) {
         worst_score = score;
         worst = p;

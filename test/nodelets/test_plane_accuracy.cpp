@@ -14,7 +14,6 @@
 // camera_height map (an up-to-scale start whose floor is mapped only after the turn)
 // meets the normal bound since the local bundle adjustment (worst 2.66 deg on
 // this seed; 1.25 deg since the floor's gate is one for all landmarks; docs/mapping.md).
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -34,6 +33,7 @@
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
+#include "support/diagnostics_probe.h"
 #include "support/test_timeouts.h"
 #include "support/temp_path.h"
 
@@ -71,17 +71,13 @@ TEST(PlaneAccuracy, RenderedSequence) {
         ++image_plane_messages;
         with_image_planes += !m->planes.empty();
       });
-  // Whether each nodelet has the camera, from its diagnostics (the plane nodelet's
-  // "camera model", the tracker's "camera_info").
-  bool plane_has_camera = false, tracker_has_camera = false;
-  ros::Subscriber diagnostics_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
-        for (const auto& status : m->status)
-          for (const auto& kv : status.values) {
-            if (kv.key == "camera model" && kv.value != "none") plane_has_camera = true;
-            if (kv.key == "camera_info" && kv.value == "ok") tracker_has_camera = true;
-          }
-      });
+  // Whether each nodelet has the camera, from its diagnostics.
+  DiagnosticsProbe tracker_status(nh, "tracker: tracking");
+  DiagnosticsProbe plane_status(nh, "plane_detector: planes");
+  auto both_have_camera = [&] {
+    const std::string model = plane_status.value("camera model");
+    return tracker_status.value("camera_info") == "ok" && !model.empty() && model != "none";
+  };
   tf2_ros::TransformBroadcaster odometry;
   spinUntil(
       [&] {
@@ -110,8 +106,8 @@ TEST(PlaneAccuracy, RenderedSequence) {
       // reach the plane nodelet before it (a different start: 174 instead of 182 images
       // placed, once too few under load); the rest are ordered by the lock-step below.
       if (images == 0) {
-        spinUntil([&] { return plane_has_camera && tracker_has_camera; }, 30.0);
-        ASSERT_TRUE(plane_has_camera && tracker_has_camera)
+        spinUntil(both_have_camera, 30.0);
+        ASSERT_TRUE(both_have_camera())
             << "the nodelets never reported the camera in their diagnostics";
       }
       continue;

@@ -47,7 +47,7 @@ double epipolarLineDistance(const cv::Matx33d& F, const cv::Point2d& x1, const c
 // and epipolarScale over every plane's points (what F's own error and the calibration
 // add). A mismatched cluster of 17 points 2.5 scales off its lines scores 6; minus
 // infinity without distances or without a positive scale.
-double epipolarOffsetScore(std::vector<double> distances, double scale_px);
+double epipolarOffsetScore(const std::vector<double>& distances, double scale_px);
 
 // The score beyond which one of `planes` planes tested together is off its epipolar lines:
 // the normal quantile of one-sided 0.1 % for all of them at once (0.1 % / planes each,
@@ -57,7 +57,7 @@ double epipolarOffsetScore(std::vector<double> distances, double scale_px);
 double epipolarOffsetThreshold(size_t planes);
 
 // The scale of distances to the epipolar lines, |N(0, s)|: their median / 0.674.
-double epipolarScale(std::vector<double> distances);
+double epipolarScale(const std::vector<double>& distances);
 
 // The algebraic form: || H^T F + F^T H || / (2 || H^T F ||) with H, F at unit norm;
 // 0 when H^T F is skew-symmetric (plane-induced), up to 1.
