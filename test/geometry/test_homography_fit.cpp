@@ -72,6 +72,23 @@ TEST(HomographyFit, TransferErrorAtInfinity) {
   EXPECT_FALSE(transfersWithin(-3.0 * kH, a, b, 1.4));
 }
 
+// The one-division form is the same error (to the last bits), scale-free in H, and
+// infinite where H sends the point to infinity.
+TEST(HomographyFit, OneDivisionErrorIsTheTransferError) {
+  for (const cv::Point2d& a : {cv::Point2d(30, 40), cv::Point2d(-200, 310), cv::Point2d(0, 0)}) {
+    for (const cv::Point2d& off : {cv::Point2d(0, 0), cv::Point2d(0, 1.5), cv::Point2d(-7, 3)}) {
+      const cv::Point2d b = transfer(kH, a) + off;
+      const double e2 = off.dot(off);
+      EXPECT_NEAR(transferErrorSquaredOneDivision(kH, a, b), e2, 1e-9 * (1 + e2));
+      EXPECT_NEAR(transferErrorSquaredOneDivision(-4.0 * kH, a, b), e2, 1e-9 * (1 + e2));
+      EXPECT_NEAR(transferErrorSquaredOneDivision(kH, a, b), transferErrorSquared(kH, a, b),
+                  1e-9 * (1 + e2));
+    }
+  }
+  const cv::Matx33d at_infinity(1, 0, 0, 0, 1, 0, 1, 0, 0);
+  EXPECT_TRUE(std::isinf(transferErrorSquaredOneDivision(at_infinity, {0, 5}, {0, 0})));
+}
+
 namespace {
 
 // The textbook normalised DLT: 9x9 normal matrix from the two rows per point, smallest

@@ -42,6 +42,12 @@ TEST(ParamTable, DefaultsAreInRangeAndNamesUnique) {
   expectSound(pipelineParamTable());
   expectSound(trackerNodeParamTable());
   expectSound(planeNodeParamTable());
+  // The stages' own tables (the pipeline's holds them nested).
+  expectSound(groupParamTable());
+  expectSound(planeParamTable());
+  expectSound(twoViewParamTable());
+  expectSound(poseParamTable());
+  expectSound(mapParamTable());
   EXPECT_EQ(trackerNodeParamTable().size(),
             trackerParamTable().size() + targetParamTable().size() + 7);  // + target_timeout_s
 }

@@ -109,6 +109,19 @@ TEST(CoplanarGroups, FindStopsAtTheCapAndCountsTries) {
     EXPECT_TRUE(isCoplanarGroup(g, scene.view1, scene.view2, params));
 }
 
+// Tries follow the number of points between the floor and the cap.
+TEST(CoplanarGroups, TriesFollowThePointsBetweenFloorAndCap) {
+  GroupParams params;
+  params.tries_per_point = 15;
+  params.min_tries = 2000;
+  params.max_tries = 6000;
+  EXPECT_EQ(triesFor(params, 0), 2000);
+  EXPECT_EQ(triesFor(params, 100), 2000);   // 1500 under the floor
+  EXPECT_EQ(triesFor(params, 200), 3000);
+  EXPECT_EQ(triesFor(params, 400), 6000);
+  EXPECT_EQ(triesFor(params, 100000), 6000);  // capped
+}
+
 // The transfer test: the fifth point's error under the other four's homography is 0 on a
 // plane and grows with the point's distance from it; in noise units it accepts coplanar
 // groups and refuses off-plane ones.

@@ -30,3 +30,18 @@ TEST(PoseMsg, RoundTripsThroughTransformAndPose) {
     EXPECT_LT(cv::norm(b.t - p.t), 1e-12);
   }
 }
+
+// A quaternion that is not of unit length (tf from a user's hand-written launch file,
+// rounded digits) is the same rotation.
+TEST(PoseMsg, QuaternionNotOfUnitLengthIsTheSameRotation) {
+  const cv::Matx33d R = cameraOrientation(0.4, -0.3, 1.1);
+  geometry_msgs::Quaternion q = toQuaternionMsg(R);
+  for (const double scale : {1.0, 0.98, 1.02, 3.0}) {
+    geometry_msgs::Quaternion s = q;
+    s.x *= scale, s.y *= scale, s.z *= scale, s.w *= scale;
+    EXPECT_LT(cv::norm(fromQuaternionMsg(s) - R, cv::NORM_INF), 1e-12) << scale;
+  }
+  // -q is the same rotation as q.
+  q.x = -q.x, q.y = -q.y, q.z = -q.z, q.w = -q.w;
+  EXPECT_LT(cv::norm(fromQuaternionMsg(q) - R, cv::NORM_INF), 1e-12);
+}
