@@ -146,11 +146,19 @@ const ParamTable<TargetParams>& targetParamTable() {
       {"min_area_px", field(&P::min_area_px), 1, 1e8, "px^2", "smaller candidates are ignored"},
       {"max_surround_ratio", field(&P::max_surround_ratio), 0.01, 1, "",
        "sheet: surround over sheet brightness along its outline (median), at most"},
+      {"dark_surround_ratio", field(&P::dark_surround_ratio), 0, 1, "",
+       "sheet: at or below this surround/sheet ratio the surround vouches for the sheet; "
+       "above it (a wall, a light table) its corners must also fix its shape "
+       "(corner_sigma_px)"},
       {"min_edge_snr", field(&P::min_edge_snr), 0, 1000, "",
        "sheet: each side's brightness step in noise standard deviations, at least"},
       {"max_aspect_error", field(&P::max_aspect_error), 0.001, 1, "",
        "sheet: rectified width/height vs width_m/height_m, relative error allowed (paper, "
        "calibration, corners)"},
+      {"corner_sigma_px", field(&P::corner_sigma_px), 0, 10, "px",
+       "sheet: how far a found corner may be off; on a light surround a candidate whose "
+       "width/height this moves by more than max_aspect_error is too small or oblique to be "
+       "judged, and refused"},
       {"dictionary", field(&P::dictionary), 0, 0, "",
        "aruco: OpenCV predefined dictionary (DICT_4X4_50, DICT_6X6_250, ...)"},
       {"marker_id", field(&P::marker_id), 0, 999, "", "aruco: the marker's id"},

@@ -498,6 +498,7 @@ int stageOf(TargetRejection r) {
     case TargetRejection::kBrightSurround: return 4;
     case TargetRejection::kEdgeContinues: return 5;
     case TargetRejection::kAspect: return 6;
+    case TargetRejection::kShapeUncertain: return 7;
     default: return 0;
   }
 }
@@ -515,6 +516,7 @@ const char* toString(TargetRejection r) {
     case TargetRejection::kBrightSurround: return "bright surround";
     case TargetRejection::kEdgeContinues: return "edge continues";
     case TargetRejection::kAspect: return "aspect ratio";
+    case TargetRejection::kShapeUncertain: return "shape uncertain";
     case TargetRejection::kNoMarker: return "no marker";
     case TargetRejection::kCount: break;
   }
@@ -575,6 +577,29 @@ std::optional<double> rectifiedAspect(const Quad& quad, cv::Size image, double f
   return r->aspect;
 }
 
+double rectifiedAspectSigma(const Quad& quad, cv::Size image, double corner_sigma_px,
+                            double focal_px, cv::Point2d principal_px) {
+  const auto a0 = rectifiedAspect(quad, image, focal_px, principal_px);
+  if (!a0) return std::numeric_limits<double>::infinity();
+  // Central differences over a step well inside the linear range (the aspect's curvature
+  // shows over pixels, not hundredths).
+  const float h = 0.05f;
+  double sum2 = 0;
+  for (int i = 0; i < 4; ++i) {
+    for (int axis = 0; axis < 2; ++axis) {
+      Quad plus = quad, minus = quad;
+      (axis == 0 ? plus[i].x : plus[i].y) += h;
+      (axis == 0 ? minus[i].x : minus[i].y) -= h;
+      const auto ap = rectifiedAspect(plus, image, focal_px, principal_px);
+      const auto am = rectifiedAspect(minus, image, focal_px, principal_px);
+      if (!ap || !am) return std::numeric_limits<double>::infinity();
+      const double d = (*ap - *am) / (2 * h);
+      sum2 += d * d;
+    }
+  }
+  return corner_sigma_px * std::sqrt(sum2) / *a0;
+}
+
 namespace {
 
 // The aspect check. With the focal length known (the nodelet: camera_info), the
@@ -582,18 +607,23 @@ namespace {
 // Unknown (a photo given to detect_target): some focal length from 0.5 to 5 image sizes
 // (a cropped photo has a long one) must make the quadrilateral a rectangle (sides within
 // 9 deg of square) of the sheet's shape.
-// Returns the relative aspect error of the best focal length, and its aspect.
-std::pair<double, double> aspectError(const Quad& quad, cv::Size image, double focal_px,
-                                      cv::Point2d principal_px, double expected) {
+// The relative aspect error of the best focal length, its aspect and that focal length.
+struct AspectFit {
+  double error = std::numeric_limits<double>::infinity();
+  double aspect = 0;
+  double focal_px = 0;
+};
+AspectFit aspectError(const Quad& quad, cv::Size image, double focal_px,
+                      cv::Point2d principal_px, double expected) {
   const cv::Mat H = squareToQuad(quad, image, focal_px > 0 ? principal_px : cv::Point2d(-1, -1));
-  std::pair<double, double> best{std::numeric_limits<double>::infinity(), 0};
+  AspectFit best;
   if (H.empty()) return best;
   auto consider = [&](double f, bool need_square) {
     const auto r = rectify(H, f);
     if (!r || (need_square && std::abs(r->cos_angle) > 0.16)) return;
     const double a = std::max(r->aspect, 1 / r->aspect);
     const double error = std::abs(a / expected - 1);
-    if (error < best.first) best = {error, a};
+    if (error < best.error) best = {error, a, f};
   };
   if (focal_px > 0) {
     // The aspect follows f about 1:1 in an oblique view, and a camera_info's focal length
@@ -671,7 +701,7 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
   double best_area = 0;
   std::optional<Quad> best;
   bool best_side0_is_width = true;
-  double best_contrast = 0, best_ratio = 0;
+  double best_contrast = 0, best_ratio = 0, best_aspect_sigma = 0;
   for (const Candidate& c : candidates) {
     if (best && c.area <= best_area) continue;  // the largest sheet wins
     double shortest = std::numeric_limits<double>::max();
@@ -730,8 +760,8 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
       reject(TargetRejection::kEdgeContinues, why.str(), c.area);
       continue;
     }
-    const auto [aspect_error, a] =
-        aspectError(*refined, gray.size(), focal_px, principal_px, expected);
+    const AspectFit fit = aspectError(*refined, gray.size(), focal_px, principal_px, expected);
+    const double aspect_error = fit.error, a = fit.aspect;
     const auto aspect = rectifiedAspect(*refined, gray.size(), focal_px, principal_px);
     if (!aspect || !(aspect_error <= params.max_aspect_error)) {
       std::ostringstream why;
@@ -746,8 +776,25 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
       reject(TargetRejection::kAspect, why.str(), c.area);
       continue;
     }
+    // On a light surround (a wall, a light table) light rectangles are everywhere, and a
+    // small or grazing one passes the shape test by chance: there the corners must fix the
+    // shape to within its tolerance. (At the focal length the test chose: with none given,
+    // the one estimated from the corners would itself move with them.)
+    const double aspect_sigma = rectifiedAspectSigma(*refined, gray.size(), params.corner_sigma_px,
+                                                     fit.focal_px, principal_px);
+    if (sides.ratio > params.dark_surround_ratio && !(aspect_sigma <= params.max_aspect_error)) {
+      std::ostringstream why;
+      why.precision(3);
+      why << "on a light surround (" << sides.ratio << ") too small or too oblique to tell "
+          << "its shape: width/height moves by " << aspect_sigma * 100 << " % for "
+          << params.corner_sigma_px << " px at the corners (needs <= "
+          << params.max_aspect_error * 100 << " %; closer, more face-on, or a darker surround)";
+      reject(TargetRejection::kShapeUncertain, why.str(), c.area);
+      continue;
+    }
     best = refined;
     best_area = c.area;
+    best_aspect_sigma = aspect_sigma;
     best_side0_is_width = *aspect >= 1;
     best_contrast = sides.inside - sides.outside;
     best_ratio = sides.ratio;
@@ -762,6 +809,7 @@ TargetDetection detectTarget(const cv::Mat& gray, const TargetParams& params, do
   out.corners = orderCorners(*best, best_side0_is_width);
   out.contrast = best_contrast;
   out.surround_ratio = best_ratio;
+  out.aspect_sigma = best_aspect_sigma;
   out.found = true;
   out.rejection = TargetRejection::kNone;
   out.reason.clear();

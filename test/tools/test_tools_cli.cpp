@@ -100,12 +100,16 @@ TEST(ToolsCli, DocsToolsPageIsEveryToolsHelp) {
 // too); exit 0 when it ran, 2 on bad usage or an unreadable image.
 TEST(ToolsCli, DetectTargetOnRealPhotos) {
   const std::string photos = std::string(TEST_DATA_DIR) + "/target_photos/";
-  ProgramRun r = run(DETECT_TARGET_PATH, photos + "test1.jpg " + photos + "test4.jpg");
+  ProgramRun r = run(DETECT_TARGET_PATH,
+                     photos + "test1.jpg " + photos + "test4.jpg " + photos + "scanned_img.jpg");
   EXPECT_EQ(r.code, 0) << r.err;
-  // test1: found, four corners; test4 (light wood): none, with the reason.
+  // test1 (dark wood) and test4 (light wood): found, four corners; a flat scan (no
+  // surround): none, with the reason.
   EXPECT_NE(r.out.find("test1.jpg: "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("test1.jpg: none"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("test4.jpg: none (bright surround"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("test4.jpg: "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("test4.jpg: none"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("scanned_img.jpg: none ("), std::string::npos) << r.out;
   r = run(DETECT_TARGET_PATH, "--json " + photos + "test3.jpg " + photos + "result.jpg");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("\"found\": true, \"corners\": [["), std::string::npos) << r.out;
