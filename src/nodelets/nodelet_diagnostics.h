@@ -93,6 +93,14 @@ class NodeletDiagnostics {
     if (rate_) rate_->tick();
   }
 
+  // Stops the timer and drops the updater now, while the nodelet's callback queue lives
+  // (a nodelet whose onInit throws is deleted after its queue: see abandonInit).
+  void stop() {
+    timer_.stop();
+    timer_ = ros::WallTimer();
+    updater_.reset();
+  }
+
   ~NodeletDiagnostics() {
     timer_.stop();
     if (updater_) updater_->broadcast(diagnostic_msgs::DiagnosticStatus::OK, "shutting down");

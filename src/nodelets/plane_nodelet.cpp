@@ -48,7 +48,40 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
 
 class PlaneNodelet : public nodelet::Nodelet {
  private:
+  // As the tracker's (tracker_nodelet.cpp): a failed start releases every ROS handle
+  // while the nodelet's callback queue lives, then the Loader refuses the nodelet.
   void onInit() override {
+    try {
+      init();
+    } catch (const std::exception& e) {
+      NODELET_ERROR("could not start (%s): not loaded", e.what());
+      abandonInit();
+      throw;
+    } catch (...) {
+      abandonInit();
+      throw;
+    }
+  }
+
+  void abandonInit() {
+    std::lock_guard<std::mutex> lock(connect_mutex_);
+    diagnostics_.stop();
+    tracks_sub_.shutdown();
+    info_sub_.shutdown();
+    image_sub_.shutdown();
+    debug_pub_.shutdown();
+    for (ros::Publisher* p : {&planes_pub_, &image_planes_pub_, &pose_pub_, &markers_pub_, &cloud_pub_})
+      p->shutdown();
+    reset_srv_.shutdown();
+    save_srv_.shutdown();
+    reconfigure_.reset();
+    tf_listener_.reset();
+    tf_buffer_.reset();
+    broadcaster_.reset();
+    image_transport_.reset();
+  }
+
+  void init() {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     guard_.setLogger(getName());

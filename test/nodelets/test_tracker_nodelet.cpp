@@ -1,6 +1,8 @@
 // Drives TrackerNodelet with images of known motion and bad input; checks `tracks`.
 #include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
+#include <nodelet/NodeletList.h>
+#include <nodelet/NodeletLoad.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -522,4 +524,30 @@ TEST_F(TrackerNodeletTest, ImagesWithoutCameraInfoAreAWarning) {
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
   EXPECT_EQ(diagnostics.message(), "images but no usable camera_info");
   EXPECT_EQ(diagnostics.value("camera_info"), "none or unusable");
+}
+
+// A tracker whose start throws (an image_transport plugin that is not installed,
+// subscribed at once with lazy: false) is refused by the manager, and the manager and
+// its other nodelets go on. It used to take the whole manager down (segfault: its
+// diagnostics timer and publishers were destroyed after the nodelet's callback queue).
+TEST_F(TrackerNodeletTest, AFailedStartLeavesTheManagerRunning) {
+  ros::param::set("/tracker_no_transport/image_transport", "no_such_transport");
+  ros::param::set("/tracker_no_transport/lazy", false);
+  nodelet::NodeletLoad load;
+  load.request.name = "/tracker_no_transport";
+  load.request.type = "mono_plane_detection/TrackerNodelet";
+  // (nodelet's load service answers false when the nodelet is refused.)
+  EXPECT_FALSE(ros::service::call("/manager/load_nodelet", load) && load.response.success);
+  scaledWait(1.0).sleep();
+  nodelet::NodeletList list;
+  ASSERT_TRUE(ros::service::call("/manager/list", list)) << "the manager died";
+  const auto& names = list.response.nodelets;
+  EXPECT_NE(std::find(names.begin(), names.end(), "/tracker"), names.end());
+  EXPECT_EQ(std::find(names.begin(), names.end(), "/tracker_no_transport"), names.end());
+  // The tracker already in the manager still tracks.
+  stamp_ += 2000;
+  TracksConstPtr tracks;
+  for (int k = 0; k < 3; ++k) tracks = send(makeImage(view({1.0 * k, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(tracks);
+  EXPECT_FALSE(tracks->id.empty());
 }
