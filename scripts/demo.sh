@@ -54,18 +54,22 @@ echo "demo: playing $bag through tracker + planes (profile $profile, $image_topi
 # Own master on a free port, so a running roscore is left alone.
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("",0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI=http://localhost:$port
-roslaunch -p "$port" mono_plane_detection replay.launch bag:="$bag" profile:="$profile" \
-  camera:="$camera" image:="$image" rviz:="$rviz" player_required:=false > "$log" 2>&1 &
-launch=$!
-trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
-for _ in $(seq 100); do rosparam get /use_sim_time >/dev/null 2>&1 && break; sleep 0.2; done
 status=0
 report_args=(--out "$results" --frames "$frames"
   --first-message-timeout "${DEMO_FIRST_MESSAGE_TIMEOUT:-60}")
 [ -z "$truth" ] || report_args+=(--truth "$truth")
+# The report first: it waits for the master and subscribes as soon as there is one, so it
+# hears the bag from its first image (started after the launch, on a loaded machine it
+# subscribed after the bag had begun and reported on 23 of 120 images).
 rosrun mono_plane_detection demo_report planes:=/$camera/planes tracks:=/$camera/tracks \
   image_planes:=/$camera/image_planes \
-  image:="$image_topic" "${report_args[@]}" || status=$?
+  image:="$image_topic" "${report_args[@]}" &
+report=$!
+roslaunch -p "$port" mono_plane_detection replay.launch bag:="$bag" profile:="$profile" \
+  camera:="$camera" image:="$image" rviz:="$rviz" player_required:=false > "$log" 2>&1 &
+launch=$!
+trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
+wait $report || status=$?
 grep -E "ERROR|FATAL" "$log" | head -5 || true
 [ $status -eq 0 ] || echo "demo: failed (exit $status); the pipeline's log: $log" >&2
 exit $status

@@ -76,6 +76,11 @@ class Report {
   int write() {
     mkdir(out_.c_str(), 0755);
     std::printf("\n=== mono_plane_detection demo: %d frames processed ===\n", planes_seen_);
+    // A partial run must not read as a whole one (what follows is about these frames).
+    if (expected_ > 0 && planes_seen_ < expected_)
+      std::printf("WARNING: planes heard for %d of the %d images: the rest were dropped by the "
+                  "pipeline (queues full under load) or came before this report subscribed\n",
+                  planes_seen_, expected_);
     std::printf("tracker nodelet: %.2f ms mean, %.2f ms p95 per frame\n", tracker_ms_.mean(),
                 tracker_ms_.p95());
     std::printf("plane nodelet:   %.2f ms mean, %.2f ms p95 per frame\n", planes_ms_.mean(),
