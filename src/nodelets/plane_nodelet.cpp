@@ -284,6 +284,10 @@ class PlaneNodelet : public nodelet::Nodelet {
       const Pose odom = fromTransformMsg(tf.transform);
       // tf2 rejects NaN but not infinity; a driver glitch can also jump far in one step.
       std::lock_guard<std::mutex> lock(mutex_);
+      // Time went backwards (a bag loop): the map starts over, and so does the jump check
+      // (against the pose from before the loop it refused the first odometry after it).
+      if (!last_odom_stamp_.isZero() && header.stamp < last_odom_stamp_) last_odom_.reset();
+      last_odom_stamp_ = header.stamp;
       const std::string error = odometryError(odom, last_odom_, max_odom_jump_m_);
       last_odom_ = odom;
       if (!error.empty()) {
@@ -443,7 +447,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       // odometry's frame, so no jump), said in diagnostics.
       odometry_stopped_ = !odom && !odom_frame_.empty() && metric_source_ == "odometry";
       if (result.was_reset) {
-        NODELET_WARN(
+        NODELET_WARN_THROTTLE(
+            5.0,
             "tracks stamp %.3f is before the previous one: time went backwards (bag "
             "loop?), the map starts over",
             frame.stamp);
@@ -611,6 +616,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   double max_odom_jump_m_ = 1.0;
   double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
   std::optional<Pose> last_odom_;
+  ros::Time last_odom_stamp_;
   std::string last_frame_id_;
   cv::Size last_tracks_size_;
   size_t observed_ = 0;

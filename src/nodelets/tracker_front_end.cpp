@@ -94,8 +94,19 @@ std::string TrackerFrontEnd::targetRejections() const {
 }
 
 double TrackerFrontEnd::targetWaitS() const {
-  if (target_startup_.found() || target_wait_start_ns_ == 0) return 0;
-  return static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
+  if (target_startup_.found()) return 0;
+  const double stretch =
+      target_wait_start_ns_ == 0
+          ? 0.0
+          : static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
+  return target_waited_before_s_ + stretch;
+}
+
+void TrackerFrontEnd::closeTargetWait() {
+  if (target_wait_start_ns_ != 0)
+    target_waited_before_s_ +=
+        static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
+  target_wait_start_ns_ = target_wait_last_ns_ = 0;
 }
 
 bool TrackerFrontEnd::targetOverdue() const {
@@ -107,6 +118,7 @@ void TrackerFrontEnd::reset() {
   tracker_.reset();
   target_startup_.reset();
   target_wait_start_ns_ = target_wait_last_ns_ = 0;
+  target_waited_before_s_ = 0;
   last_stamp_ns_ = 0;
   last_size_ = cv::Size();
   last_frame_id_.clear();
@@ -151,6 +163,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     tracker_.reset();
     target_startup_.reset();
     gaps_.reset();
+    closeTargetWait();
   } else if (last_stamp_ns_ != 0 && stamp_ns < last_stamp_ns_) {
     out.warnings.push_back({"backwards", "image stamp " + seconds(stamp_ns) +
                                              " is before the previous one (" +
@@ -160,6 +173,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     tracker_.reset();
     target_startup_.reset();
     gaps_.reset();
+    closeTargetWait();
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
     if (gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s)) {
@@ -171,6 +185,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
       tracker_.reset();
       target_startup_.reset();
       gaps_.addPause(static_cast<int64_t>(gap_ns));
+      closeTargetWait();
     } else {
       counts_.missing += gaps_.add(static_cast<int64_t>(gap_ns));
     }
@@ -198,10 +213,9 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   // Paper II-A: until the start-up target is seen, look for it; its corners become
   // tracked points flagged as target corners.
   if (params_.detect_target && !target_startup_.found()) {
-    // The wait counts from the first image searched (after a reset too: the reset
-    // already said why), in image stamps.
-    if (target_wait_start_ns_ == 0 || stamp_ns < target_wait_start_ns_)
-      target_wait_start_ns_ = stamp_ns;
+    // The wait counts in image stamps over the stretches searched since the last reset()
+    // (a jump or pause of the stamps closes one: its length is no waiting).
+    if (target_wait_start_ns_ == 0) target_wait_start_ns_ = stamp_ns;
     target_wait_last_ns_ = stamp_ns;
     if (const auto target =
             target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,

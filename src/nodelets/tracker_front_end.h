@@ -91,6 +91,10 @@ class TrackerFrontEnd {
   bool lens_fisheye_ = false;
   uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
   uint64_t target_wait_last_ns_ = 0;
+  // Waited in earlier stretches of the stream, s: a jump of the stamps (bag loop, a bad
+  // driver clock) or a pause closes a stretch; the jump itself is no waiting.
+  double target_waited_before_s_ = 0;
+  void closeTargetWait();
   GapCounter gaps_;
   TrackerCounts counts_;
 };

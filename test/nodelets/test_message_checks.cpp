@@ -327,6 +327,14 @@ TEST(TrackerFrontEnd, NoTargetWarnsAfterTheTimeoutWithTheReason) {
   front.reset();  // nobody listens: the wait starts again
   EXPECT_FALSE(front.targetOverdue());
   EXPECT_EQ(front.targetWaitS(), 0.0);
+  // One image stamped 1000 s (a bad driver clock), then the real stamps again: the jumps
+  // are no waiting (hostile try: "no start-up target for 1796233216.6 s", for good).
+  for (int k = 0; k <= 10; ++k) front.process(image(grey, 100 + k / 10, (k % 10) * 100000000));
+  front.process(image(grey, 1000, 0));
+  front.process(image(grey, 1000, 100000000));
+  for (int k = 0; k <= 10; ++k) front.process(image(grey, 102 + k / 10, (k % 10) * 100000000));
+  EXPECT_NEAR(front.targetWaitS(), 1.0 + 0.1 + 1.0, 1e-6);
+  EXPECT_TRUE(front.targetOverdue());  // 2.1 s of images searched, over the 2 s
 }
 
 // The focal length from camera_info reaches the detector: a square seen head-on is not an
