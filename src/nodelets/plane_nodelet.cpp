@@ -9,6 +9,7 @@
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
@@ -69,6 +70,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     tracks_sub_.shutdown();
     info_sub_.shutdown();
     image_sub_.shutdown();
+    static_sub_.shutdown();
     debug_pub_.shutdown();
     for (ros::Publisher* p : {&planes_pub_, &image_planes_pub_, &pose_pub_, &markers_pub_, &cloud_pub_})
       p->shutdown();
@@ -125,6 +127,12 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
+    // tf2 keeps one cache per frame: a static parent that comes after our own dynamic
+    // link to the same child hides behind it there. Static links are few and latched:
+    // their parents are kept here for the tf check.
+    if (publish_tf_)
+      static_sub_ = nh.subscribe<tf2_msgs::TFMessage>(
+          "/tf_static", 10, guard_.message("tf_static", this, &PlaneNodelet::onTfStatic));
     node_ = node;
     startReconfigure(pnh);
     reset_srv_ = pnh.advertiseService("reset", &PlaneNodelet::onReset, this);
@@ -309,7 +317,24 @@ class PlaneNodelet : public nodelet::Nodelet {
   // Why publishing parent -> child would break the tf tree (REP 105), "" when it would
   // not. tf2 keeps the latest parent of each frame: another broadcaster of `child` shows
   // as another parent, or, before our first transform, as the same edge already there.
+  void onTfStatic(const tf2_msgs::TFMessageConstPtr& msg) {
+    std::lock_guard<std::mutex> lock(static_mutex_);
+    for (const auto& t : msg->transforms) {
+      auto strip = [](const std::string& f) { return f.rfind('/', 0) == 0 ? f.substr(1) : f; };
+      static_parents_[strip(t.child_frame_id)] = strip(t.header.frame_id);
+    }
+  }
+
   std::string tfConflict(const std::string& parent, const std::string& child) const {
+    {
+      // We never publish static links: any static link to our child is another's.
+      std::lock_guard<std::mutex> lock(static_mutex_);
+      const auto it = static_parents_.find(child);
+      if (it != static_parents_.end())
+        return "frame '" + child + "' has the static parent '" + it->second +
+               "' on tf_static: publishing " + parent + " -> " + child +
+               " would give it a second parent";
+    }
     std::string existing;
     if (tf_buffer_->_getParent(child, ros::Time(0), existing)) {
       if (existing != parent)
@@ -591,7 +616,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   double target_timeout_s_ = 30;
 
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
-  ros::Subscriber tracks_sub_, info_sub_;
+  ros::Subscriber tracks_sub_, info_sub_, static_sub_;
+  mutable std::mutex static_mutex_;
+  std::map<std::string, std::string> static_parents_;  // child -> parent on /tf_static
   ros::ServiceServer reset_srv_, save_srv_;
   std::unique_ptr<dynamic_reconfigure::Server<PlanesConfig>> reconfigure_;
   std::map<std::string, std::string> cfg_names_;  // .cfg name -> table name

@@ -274,7 +274,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
   PlaneArrayConstPtr last;
   Pose truth_map_from_base;
   ros::Time last_stamp;
-  for (int k = 0; k < 150; ++k) {
+  auto sendFrame = [&](int k) {
     const double t = k / 30.0;
     TrackFrame f = world.frame(t);
     f.stamp = (start + ros::Duration(t)).toSec();
@@ -303,6 +303,10 @@ TEST(TfTree, StaysATreeWithOdometry) {
     ASSERT_TRUE(last) << "image " << k;
     ASSERT_TRUE(conflict_planes.wait(stamp)) << "image " << k;
     last_stamp = stamp;
+  };
+  for (int k = 0; k < 150; ++k) {
+    sendFrame(k);
+    if (HasFatalFailure()) return;
   }
   EXPECT_EQ(last->status, "tracking (odometry)");
   spinUntil([] { return false; }, 1.0);  // the last transforms arrive
@@ -333,6 +337,39 @@ TEST(TfTree, StaysATreeWithOdometry) {
     std::string parent;
     ASSERT_TRUE(buffer._getParent("odom", ros::Time(0), parent));
     EXPECT_EQ(parent, "map");  // the localiser's link is untouched
+  }
+
+  if (!localiser) {
+    // A static map -> odom that comes after the pipeline's plane_map -> odom (a
+    // static_transform_publisher started later). tf2 hides a late static parent behind
+    // the dynamic link to the same frame; odom got two parents, silently (hostile try).
+    // The nodelet must stop publishing, with an ERROR that says why.
+    geometry_msgs::TransformStamped late;
+    // Stamped 0, as a static_transform_publisher started under simulated time before
+    // /clock stamps it: tf2 drops it from odom's cache (older than our links), so only
+    // /tf_static shows it.
+    late.header.stamp = ros::Time(0);
+    late.header.frame_id = "map";
+    late.child_frame_id = "odom";
+    late.transform = toTransformMsg(amcl_map_from_odom);
+    urdf.sendTransform(late);  // the broadcaster keeps the URDF's mount as well
+    scaledWait(1.0).sleep();
+    int ours_after = 0;
+    ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>(
+        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+          for (const auto& t : m->transforms)
+            ours_after += t.child_frame_id == "odom" && t.header.frame_id == "plane_map";
+        });
+    for (int k = 150; k < 170; ++k) {
+      sendFrame(k);
+      if (HasFatalFailure()) return;
+    }
+    spinUntil([] { return false; }, 1.0);
+    EXPECT_EQ(ours_after, 0) << "plane_map -> odom still published beside the static map -> odom";
+    DiagnosticsProbe camera(nh, "camera/plane_detector: planes");
+    ASSERT_TRUE(camera.waitFresh());
+    EXPECT_EQ(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
+    EXPECT_NE(camera.message().find("second parent"), std::string::npos) << camera.message();
   }
 
   // The nodelet told to publish the camera's own frame refused, loudly.
