@@ -30,6 +30,7 @@
 #include "mono_plane_detection/viz/draw_planes.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
+#include "recent_events.h"
 #include "ros_params.h"
 
 namespace mono_plane_detection {
@@ -226,8 +227,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (error.empty()) error = pipeline_->setCamera(camera.K, camera.D);
     if (!error.empty()) {
       ++dropped_info_;
-      NODELET_WARN_THROTTLE(10.0, "camera_info rejected: %s; image-space planes only",
-                            error.c_str());
+      // One throttle per reason: an unknown distortion model after a zero K is named too.
+      if (problems_.note("camera_info " + reasonKind(error), "camera_info rejected: " + error, 10.0))
+        NODELET_WARN("camera_info rejected: %s; image-space planes only", error.c_str());
       return;
     }
     camera_ = camera;
@@ -300,6 +302,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       last_odom_ = odom;
       if (!error.empty()) {
         ++refused_odom_;
+        problems_.note("odometry refused", "odometry refused: " + error);
         NODELET_WARN_THROTTLE(5.0, "odometry %s -> %s at %.3f refused (%s): visual pose used",
                               odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
                               error.c_str());
@@ -418,7 +421,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!error.empty()) {
       std::lock_guard<std::mutex> lock(mutex_);
       ++dropped_;
-      NODELET_ERROR_THROTTLE(5.0, "tracks dropped: %s", error.c_str());
+      if (problems_.note("tracks " + reasonKind(error), "tracks dropped: " + error))
+        NODELET_ERROR("tracks dropped: %s", error.c_str());
       return;
     }
     const std::optional<Pose> odom = odometry(msg->header);
@@ -564,7 +568,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     else if (no_camera)  // the present state first, then what happened since the start
       status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
     else if (lost)
-      status.summary(DiagnosticStatus::WARN, "tracking lost: " + status_);
+      status.summary(DiagnosticStatus::WARN, status_.rfind("lost", 0) == 0
+                                                 ? "tracking " + status_
+                                                 : "tracking lost: " + status_);
     else if (odometry_stopped_)
       status.summary(DiagnosticStatus::WARN,
                      "odometry (" + odom_frame_ + ") stopped: camera pose from vision only");
@@ -578,8 +584,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.summary(DiagnosticStatus::WARN, "exceptions caught");
     else if (camera_switches_ > 0)
       status.summary(DiagnosticStatus::WARN, "tracks mix cameras");
-    else if (dropped_ > 0 || dropped_info_ > 0 || refused_odom_ > 0)
-      status.summary(DiagnosticStatus::WARN, status_.empty() ? "input refused" : status_);
+    else if (const std::string recent = problems_.recent(kRecentS); !recent.empty())
+      status.summary(DiagnosticStatus::WARN, recent);  // while recent; the totals stay below
     else
       status.summary(DiagnosticStatus::OK, status_.empty() ? "no tracks yet" : status_);
     status.add("exceptions caught (total)", exceptions);
@@ -628,6 +634,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  RecentEvents problems_;  // refused tracks, camera_info, odometry
+  static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
   NodeletDiagnostics diagnostics_;
 
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline

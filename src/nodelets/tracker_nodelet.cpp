@@ -17,6 +17,7 @@
 #include "camera_info_check.h"
 #include "mono_plane_detection/viz/draw_tracks.h"
 #include "nodelet_diagnostics.h"
+#include "recent_events.h"
 #include "ros_params.h"
 #include "tracker_front_end.h"
 
@@ -109,9 +110,10 @@ class TrackerNodelet : public nodelet::Nodelet {
   void infoCallback(const sensor_msgs::CameraInfoConstPtr& info) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const std::string error = front_.setCameraInfo(*info);
-    if (!error.empty())
-      NODELET_WARN_THROTTLE(10.0, "camera_info unusable (%s): ignored, tracking goes on in pixels",
-                            error.c_str());
+    if (!error.empty() && problems_.note("camera_info " + reasonKind(error),
+                                         "camera_info unusable: " + error, 10.0))
+      NODELET_WARN("camera_info unusable (%s): ignored, tracking goes on in pixels",
+                   error.c_str());
   }
 
   // Lazy subscription: nobody listens, nothing is tracked. Tracking restarts fresh
@@ -156,10 +158,13 @@ class TrackerNodelet : public nodelet::Nodelet {
                               front_.params().target.target_type.c_str(),
                               front_.targetReason().c_str());
       if (!out.tracks) {
-        if (out.dropped_is_error)
-          NODELET_ERROR_THROTTLE(5.0, "dropping image: %s", out.dropped.c_str());
-        else
-          warn({"dropped", "dropping image: " + out.dropped});
+        // One throttle per reason: each kind of bad image is named at least once.
+        if (problems_.note(reasonKind(out.dropped), "image dropped: " + out.dropped)) {
+          if (out.dropped_is_error)
+            NODELET_ERROR("dropping image: %s", out.dropped.c_str());
+          else
+            NODELET_WARN("dropping image: %s", out.dropped.c_str());
+        }
         return;
       }
     }
@@ -196,13 +201,22 @@ class TrackerNodelet : public nodelet::Nodelet {
     // plane nodelet needs it for metres and the target check for the sheet's aspect.
     const bool no_info = !front_.hasCameraInfo() && !first_image_.isZero() &&
                          (ros::WallTime::now() - first_image_).toSec() > kCameraInfoGraceS;
+    // Drops and camera switches count for the level while recent: the totals stay below.
+    const std::string recent = problems_.recent(kRecentS);
+    const bool switched = c.camera_switches > reported_switches_;
+    if (switched) {
+      reported_switches_ = c.camera_switches;
+      last_switch_ = ros::WallTime::now();
+    }
+    const bool recent_switch =
+        !last_switch_.isZero() && (ros::WallTime::now() - last_switch_).toSec() <= kRecentS;
     const bool warn =
-        c.dropped > 0 || c.camera_switches > 0 || exceptions > 0 || no_target || no_info;
+        !recent.empty() || recent_switch || exceptions > 0 || no_target || no_info;
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
-                   : c.camera_switches > 0 ? "image stream mixes cameras"
-                   : c.dropped > 0         ? "images dropped"
+                   : recent_switch        ? "image stream mixes cameras"
+                   : !recent.empty()      ? recent
                    : no_info               ? std::string("images but no usable camera_info")
                    : no_target            ? "no start-up target: " + front_.targetReason()
                                            : std::string("tracking"));
@@ -254,6 +268,11 @@ class TrackerNodelet : public nodelet::Nodelet {
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // front_ and the log throttles
   std::map<std::string, ros::WallTime> last_warned_;
+
+  RecentEvents problems_;  // dropped images, unusable camera_info
+  static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
+  long reported_switches_ = 0;
+  ros::WallTime last_switch_;
 
   NodeletDiagnostics diagnostics_;
 };
