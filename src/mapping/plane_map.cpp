@@ -256,6 +256,22 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
   return ids;
 }
 
+int PlaneMap::addKnownPlane(const PlaneObservation& obs, double stamp) {
+  PlaneFit fit = fitPlane(obs.points, params_.max_residual_m, params_.min_points);
+  if (!fit.ok) return -1;
+  orientTowards(fit, obs.viewpoint);
+  PlaneObservation kept;
+  kept.viewpoint = obs.viewpoint;
+  for (int i : fit.inliers) {
+    kept.ids.push_back(obs.ids[i]);
+    kept.points.push_back(obs.points[i]);
+  }
+  const int id = fuse(kept, fit.normal, fit.distance, stamp);
+  mergeDuplicates(obs.viewpoint);
+  fadeAndBound(stamp);
+  return id;
+}
+
 int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance,
                    double stamp) {
   const int match = associate(normal, distance, kept);

@@ -87,6 +87,7 @@ void PoseEstimator::reset() {
   floor_check_.reset();
   checking_pose_.reset();
   correction_ = Similarity();
+  checked_floor_ = CheckedFloor();
   keyframes_.clear();
 }
 
@@ -196,7 +197,7 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   if (params_.bundle_window > 0 && estimate->source != PoseSource::kOdometry && !vision_only_)
     bundleAdjust(frame, normalized, *estimate);
   forgetOldLandmarks();
-  if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) {
+  if (floor_check_ && !checkFloor(frame.stamp, *estimate, odom_from_camera)) {
     if (floor_check_ && floor_check_->unscaled) checking_pose_ = estimate;
     return {};
   }
@@ -221,7 +222,7 @@ void PoseEstimator::undoFloorStart(const std::string& why) {
   keyframes_.clear();
 }
 
-bool PoseEstimator::checkFloor(PoseEstimate& estimate,
+bool PoseEstimator::checkFloor(double stamp, PoseEstimate& estimate,
                                const std::optional<Pose>& odom_from_camera) {
   FloorCheck& check = *floor_check_;
   const FloorParams& p = params_.floor;
@@ -243,9 +244,11 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   std::vector<cv::Vec3d> points;
   std::vector<double> sigma;
   std::vector<cv::Vec3d> anchors;
+  std::vector<std::uint64_t> ids;
   const double angle = 1.0 / K_(0, 0);  // a pixel
   for (const auto& [id, l] : landmarks_) {
     if (!l.triangulated || l.provisional || l.parallax_deg <= 0) continue;
+    ids.push_back(id);
     points.push_back(l.position);
     anchors.push_back(l.anchor_pose.t);
     const double depth = cv::norm(l.position - l.anchor_pose.t);
@@ -337,6 +340,9 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
   estimate.map_from_camera = s.apply(estimate.map_from_camera);
   last_pose_ = estimate.map_from_camera;
   correction_ = s;
+  checked_floor_.ids.clear();
+  for (int i : fit.inliers) checked_floor_.ids.push_back(ids[static_cast<size_t>(i)]);
+  checked_floor_.stamp = stamp;
   if (odom_from_camera) map_from_odom_ = estimate.map_from_camera * odom_from_camera->inverse();
   floor_check_.reset();
   floor_reason_.clear();

@@ -270,3 +270,47 @@ TEST(PlaneMap, AStripOfPointsIsNeverConfirmed) {
   ASSERT_EQ(wide.planes().size(), 1u);
   EXPECT_TRUE(wide.planes()[0].confirmed(wide.params()));
 }
+
+// camera_height: the floor landmarks the start's check fitted the map to (a strip along a
+// wall, 0.5 m wide, seen in two stretches 0.3 m apart) are one plane by that check: taken
+// whole, not split as an image plane's mixture; the image planes of the floor (a few of
+// its landmarks each) join it.
+TEST(PlaneMap, AKnownPlaneIsTakenWholeAndTheImagesJoinIt) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> across(-3.0, -2.5), near(-1.6, -0.3), far(0.0, 1.3);
+  std::normal_distribution<double> noise(0, 0.01);
+  PlaneObservation floor;
+  floor.viewpoint = cv::Vec3d(-1.3, 1.2, -0.7);
+  for (int i = 0; i < 32; ++i) {
+    floor.ids.push_back(100 + i);
+    floor.points.emplace_back(across(rng), noise(rng), i < 16 ? near(rng) : far(rng));
+  }
+  PlaneMap map;
+  const int id = map.addKnownPlane(floor, 1000);
+  ASSERT_GE(id, 0);
+  ASSERT_EQ(map.planes().size(), 1u);
+  const MapPlane& plane = map.planes()[0];
+  EXPECT_EQ(plane.points.size(), floor.points.size());
+  EXPECT_LT(normalAngleDeg(plane.normal, kFloor), 1.0);
+  EXPECT_NEAR(plane.distance, 0.0, 0.01);
+  EXPECT_EQ(plane.observations, 1);
+  EXPECT_FALSE(plane.confirmed(map.params()));
+  // Two images see 8 of its landmarks and 4 new ones each, from viewpoints 0.5 m apart.
+  for (int k = 1; k <= 2; ++k) {
+    PlaneObservation image;
+    image.viewpoint = floor.viewpoint + cv::Vec3d(0, 0, 0.5 * k);
+    for (int i = 0; i < 8; ++i) {
+      image.ids.push_back(floor.ids[8 * k + i]);
+      image.points.push_back(floor.points[8 * k + i] + cv::Vec3d(0, noise(rng), 0));
+    }
+    for (int i = 0; i < 4; ++i) {
+      image.ids.push_back(200 + 10 * k + i);
+      image.points.emplace_back(across(rng), noise(rng), far(rng));
+    }
+    EXPECT_EQ(map.update({image}, 1000 + 0.1 * k)[0], id);
+  }
+  ASSERT_EQ(map.planes().size(), 1u);
+  EXPECT_EQ(map.planes()[0].points.size(), floor.points.size() + 8);
+  EXPECT_TRUE(map.planes()[0].confirmed(map.params()));
+  EXPECT_LT(normalAngleDeg(map.planes()[0].normal, kFloor), 1.0);
+}

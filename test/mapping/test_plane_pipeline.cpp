@@ -1,6 +1,8 @@
 // The plane stage end to end on synthetic tracks with known planes and poses.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "support/synthetic_tracks.h"
@@ -258,4 +260,81 @@ TEST(PlanePipeline, PlanesSeenWhileAnUnscaledStartIsCheckedAreMapped) {
   for (const MapPlane& p : pipeline.map().planes())
     earlier += p.confirmed(pipeline.map().params()) && p.first_seen < first_pose - 1.0;
   EXPECT_GE(earlier, 1) << "no plane from the images seen while checking";
+}
+
+// camera_height, an up-to-scale start whose floor is seen little (a humanoid's head): the
+// check fits the map's up and scale to 30 or more floor landmarks, while each image plane
+// of the floor holds a few of them. The map's floor plane holds the check's landmarks from
+// the first metric image on, so it is as level as the map (measured: without them, the
+// rendered humanoid's noise seed 7 mapped its floor from 10 points, 1.92 deg off, 6.1 %
+// of its distance; with them 0.53 deg, 0.4 %). Here (15 % of the floor's points, seed 3)
+// without them: no floor in the map at the first metric image, at the end an unconfirmed
+// one 6.2 deg off; with them 35 points 0.3 deg off, at the end confirmed, 0.7 deg.
+TEST(PlanePipeline, TheFloorTheCheckFittedIsTheMapsFloor) {
+  const unsigned seed = 3;
+  SyntheticTracks world("humanoid", 100, seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<cv::Vec3d> points;
+  std::vector<int> plane_of;
+  for (size_t i = 0; i < world.points.size(); ++i)
+    if (world.scene.planes[world.plane_of[i]].name != "floor" || unit(rng) < 0.15) {
+      points.push_back(world.points[i]);
+      plane_of.push_back(world.plane_of[i]);
+    }
+  world.points = points;
+  world.plane_of = plane_of;
+  PipelineParams params;
+  params.pose.metric_source = "camera_height";
+  params.pose.floor.camera_height_m = 1.2;
+  PlanePipeline pipeline(params);
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  const cv::Vec3d up(0, 1, 0);  // the truth's (the target's frame: y up)
+  // The truth's orientation of the map from the cameras' (summed over the placed images):
+  // well fixed by each, while the short straight path after the turn fixes the rotation
+  // about it only by the head's 2 cm of bob and sway.
+  cv::Matx33d truth_from_map_sum = cv::Matx33d::zeros();
+  int placed = 0;
+  auto floorPlane = [&](const PlanePipeline& p) -> const MapPlane* {
+    const MapPlane* best = nullptr;
+    for (const MapPlane& plane : p.map().planes())
+      if (plane.normal.dot(up) > 0.9 && (!best || plane.points.size() > best->points.size()))
+        best = &plane;
+    return best;
+  };
+  for (int k = 0; k < 300; ++k) {
+    TrackFrame f = world.frame(k / 30.0, 0.5, seed), room = f;  // no target in this room
+    room.ids.clear();
+    room.pixels.clear();
+    room.target_corner.clear();
+    for (size_t i = 0; i < f.ids.size(); ++i)
+      if (!f.target_corner[i]) {
+        room.ids.push_back(f.ids[i]);
+        room.pixels.push_back(f.pixels[i]);
+        room.target_corner.push_back(false);
+      }
+    const PipelineResult r = pipeline.process(room);
+    if (!r.pose) continue;
+    const cv::Matx33d truth_from_map =
+        world.truthMapFromCamera(k / 30.0).R * r.pose->map_from_camera.R.t();
+    truth_from_map_sum += truth_from_map;
+    if (placed++ > 0) continue;
+    const MapPlane* floor = floorPlane(pipeline);
+    EXPECT_NE(floor, nullptr) << "no floor in the map at the first metric image " << k;
+    if (!floor) continue;
+    EXPECT_GE(floor->points.size(), static_cast<size_t>(params.pose.floor.min_check_points));
+    size_t held = 0;
+    for (std::uint64_t id : pipeline.poseEstimator()->checkedFloor().ids)
+      held += floor->points.count(id);
+    EXPECT_GE(held, static_cast<size_t>(params.pose.floor.min_check_points)) << "the check's floor";
+    EXPECT_LT(normalAngleDeg(truth_from_map * floor->normal, up), 1.5);
+  }
+  ASSERT_GE(placed, 20) << "no metric start";
+  cv::Mat w, u, vt;
+  cv::SVD::compute(cv::Mat(truth_from_map_sum), w, u, vt);
+  const cv::Matx33d truth_from_map(cv::Mat(u * vt));
+  const MapPlane* floor = floorPlane(pipeline);
+  ASSERT_NE(floor, nullptr) << "no floor in the map";
+  EXPECT_TRUE(floor->confirmed(pipeline.map().params()));
+  EXPECT_LT(normalAngleDeg(truth_from_map * floor->normal, up), 1.5);
 }

@@ -85,6 +85,11 @@ class PlaneMap {
   // the same homography): each is fused; the id returned is the largest's.
   std::vector<int> update(const std::vector<PlaneObservation>& observations, double stamp);
 
+  // Fuses points known to lie on one plane (camera_height: the floor landmarks the
+  // start's check fitted the map's floor to), without the image planes' split into
+  // surfaces; returns the map plane's id, -1 when they fit no plane.
+  int addKnownPlane(const PlaneObservation& observation, double stamp);
+
   const std::vector<MapPlane>& planes() const { return planes_; }
   const MapParams& params() const { return params_; }
   void reset();

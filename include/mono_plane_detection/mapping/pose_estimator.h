@@ -110,6 +110,13 @@ class PoseEstimator {
   const std::optional<PoseEstimate>& checkingPose() const { return checking_pose_; }
   // The similarity the last floor check applied to the map (identity before).
   const Similarity& floorCorrectionApplied() const { return correction_; }
+  // camera_height: the landmarks the passed floor check fitted the floor to (ids) and
+  // the stamp of that image (-1 before).
+  struct CheckedFloor {
+    std::vector<std::uint64_t> ids;
+    double stamp = -1;
+  };
+  const CheckedFloor& checkedFloor() const { return checked_floor_; }
   // What the start waits for, for people ("waiting for target", ...).
   std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
@@ -179,7 +186,8 @@ class PoseEstimator {
   // camera_height: checks the start against the floor its landmarks show; true once the
   // map has been corrected (poses may be given out), false while waiting; undoes the
   // start when the floor disagrees.
-  bool checkFloor(PoseEstimate& estimate, const std::optional<Pose>& odom_from_camera);
+  bool checkFloor(double stamp, PoseEstimate& estimate,
+                  const std::optional<Pose>& odom_from_camera);
   void undoFloorStart(const std::string& why);
   // Tracks of this image with a landmark position (landmarkPosition).
   int landmarksInView(const TrackFrame& frame) const;
@@ -235,6 +243,7 @@ class PoseEstimator {
   std::optional<FloorCheck> floor_check_;
   std::optional<PoseEstimate> checking_pose_;
   Similarity correction_;
+  CheckedFloor checked_floor_;
   struct Keyframe {
     double stamp = -1;
     Pose map_from_camera;
