@@ -76,4 +76,24 @@ class CallbackGuard {
   std::string last_;
 };
 
+// A nodelet's onInit: nodelet's Loader deletes a nodelet whose onInit threw only after
+// it has deleted the nodelet's callback queues, so every timer, publisher (with connect
+// callbacks), subscriber and service made so far must go first (`abandon`), or their
+// destructors use the freed queue and the whole manager dies (e.g. an image_transport
+// plugin that is not installed, with lazy: false). The exception is then passed on: the
+// Loader refuses the nodelet with an ERROR, the manager and its other nodelets go on.
+template <class Init, class Abandon>
+void initOrAbandon(const std::string& logger, Init&& init, Abandon&& abandon) {
+  try {
+    init();
+  } catch (const std::exception& e) {
+    ROS_ERROR_STREAM_NAMED(logger, logger << ": could not start (" << e.what() << "): not loaded");
+    abandon();
+    throw;
+  } catch (...) {
+    abandon();
+    throw;
+  }
+}
+
 }  // namespace mono_plane_detection

@@ -94,7 +94,7 @@ class NodeletDiagnostics {
   }
 
   // Stops the timer and drops the updater now, while the nodelet's callback queue lives
-  // (a nodelet whose onInit throws is deleted after its queue: see abandonInit).
+  // (a nodelet whose onInit throws is deleted after its queue: initOrAbandon, callback_guard.h).
   void stop() {
     timer_.stop();
     timer_ = ros::WallTimer();

@@ -50,19 +50,8 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
 
 class PlaneNodelet : public nodelet::Nodelet {
  private:
-  // As the tracker's (tracker_nodelet.cpp): a failed start releases every ROS handle
-  // while the nodelet's callback queue lives, then the Loader refuses the nodelet.
   void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      NODELET_ERROR("could not start (%s): not loaded", e.what());
-      abandonInit();
-      throw;
-    } catch (...) {
-      abandonInit();
-      throw;
-    }
+    initOrAbandon(getName(), [this] { init(); }, [this] { abandonInit(); });
   }
 
   void abandonInit() {

@@ -31,23 +31,8 @@ class TrackerNodelet : public nodelet::Nodelet {
   }
 
  private:
-  // nodelet's Loader deletes a nodelet whose onInit threw only after it has deleted the
-  // nodelet's callback queues: every timer, publisher (with connect callbacks),
-  // subscriber and service made so far must go now, or their destructors use the freed
-  // queue and the whole manager dies (e.g. an image_transport plugin that is not
-  // installed, with lazy: false). The exception then tells the Loader, which refuses the
-  // nodelet with an ERROR and leaves the manager and its other nodelets running.
   void onInit() override {
-    try {
-      init();
-    } catch (const std::exception& e) {
-      NODELET_ERROR("could not start (%s): not loaded", e.what());
-      abandonInit();
-      throw;
-    } catch (...) {
-      abandonInit();
-      throw;
-    }
+    initOrAbandon(getName(), [this] { init(); }, [this] { abandonInit(); });
   }
 
   void abandonInit() {

@@ -240,16 +240,7 @@ TEST(PlanePipeline, PlanesSeenWhileAnUnscaledStartIsCheckedAreMapped) {
   double first_pose = -1;
   bool map_before_pose = false;
   for (int k = 0; k < 240; ++k) {
-    TrackFrame f = world.frame(k / 30.0), room = f;  // the room as if no target hung there
-    room.ids.clear();
-    room.pixels.clear();
-    room.target_corner.clear();
-    for (size_t i = 0; i < f.ids.size(); ++i)
-      if (!f.target_corner[i]) {
-        room.ids.push_back(f.ids[i]);
-        room.pixels.push_back(f.pixels[i]);
-        room.target_corner.push_back(false);
-      }
+    const TrackFrame room = withoutTarget(world.frame(k / 30.0));
     const PipelineResult r = pipeline.process(room);
     if (!r.pose) map_before_pose |= !pipeline.map().planes().empty();
     if (r.pose && first_pose < 0) first_pose = room.stamp;
@@ -303,16 +294,7 @@ TEST(PlanePipeline, TheFloorTheCheckFittedIsTheMapsFloor) {
     return best;
   };
   for (int k = 0; k < 300; ++k) {
-    TrackFrame f = world.frame(k / 30.0, 0.5, seed), room = f;  // no target in this room
-    room.ids.clear();
-    room.pixels.clear();
-    room.target_corner.clear();
-    for (size_t i = 0; i < f.ids.size(); ++i)
-      if (!f.target_corner[i]) {
-        room.ids.push_back(f.ids[i]);
-        room.pixels.push_back(f.pixels[i]);
-        room.target_corner.push_back(false);
-      }
+    const TrackFrame room = withoutTarget(world.frame(k / 30.0, 0.5, seed));  // no target here
     const PipelineResult r = pipeline.process(room);
     if (!r.pose) continue;
     const cv::Matx33d truth_from_map =

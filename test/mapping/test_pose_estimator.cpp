@@ -197,20 +197,6 @@ TEST(PoseEstimator, SourceNames) {
 // ---- Metres without a target (metric_source odometry, camera_height, auto) ----
 namespace {
 
-TrackFrame withoutTarget(const TrackFrame& f) {  // the room as if no target hung there
-  TrackFrame out = f;
-  out.ids.clear();
-  out.pixels.clear();
-  out.target_corner.clear();
-  for (size_t i = 0; i < f.ids.size(); ++i)
-    if (!f.target_corner[i]) {
-      out.ids.push_back(f.ids[i]);
-      out.pixels.push_back(f.pixels[i]);
-      out.target_corner.push_back(false);
-    }
-  return out;
-}
-
 PoseParams source(const std::string& name, double camera_height_m = 0) {
   PoseParams p;
   p.metric_source = name;

@@ -75,4 +75,19 @@ struct SyntheticTracks {
   }
 };
 
+// The room as if no target hung there: the frame without the target's corners.
+inline TrackFrame withoutTarget(const TrackFrame& f) {
+  TrackFrame out = f;
+  out.ids.clear();
+  out.pixels.clear();
+  out.target_corner.clear();
+  for (size_t i = 0; i < f.ids.size(); ++i)
+    if (!f.target_corner[i]) {
+      out.ids.push_back(f.ids[i]);
+      out.pixels.push_back(f.pixels[i]);
+      out.target_corner.push_back(false);
+    }
+  return out;
+}
+
 }  // namespace mono_plane_detection
