@@ -119,12 +119,11 @@ class TrackerNodelet : public nodelet::Nodelet {
 
   // One throttle per kind of event, so that one kind never hides another.
   void warn(const LogEvent& event) {
-    const ros::WallTime now = ros::WallTime::now();
-    ros::WallTime& last = last_warned_[event.kind];
-    if (!last.isZero() && (now - last).toSec() < 5.0) return;
-    last = now;
-    NODELET_WARN("%s", event.text.c_str());
+    // A camera switch is also a problem of the stream for diagnostics (while recent).
+    if (event.kind == "camera switch") problems_.note("camera switch", "image stream mixes cameras");
+    if (logged_.note(event.kind, event.text)) NODELET_WARN("%s", event.text.c_str());
   }
+
 
   void imageCallback(const sensor_msgs::ImageConstPtr& msg) {
     diagnostics_.tick();
@@ -188,19 +187,10 @@ class TrackerNodelet : public nodelet::Nodelet {
                          (ros::WallTime::now() - first_image_).toSec() > kCameraInfoGraceS;
     // Drops and camera switches count for the level while recent: the totals stay below.
     const std::string recent = problems_.recent(kRecentS);
-    const bool switched = c.camera_switches > reported_switches_;
-    if (switched) {
-      reported_switches_ = c.camera_switches;
-      last_switch_ = ros::WallTime::now();
-    }
-    const bool recent_switch =
-        !last_switch_.isZero() && (ros::WallTime::now() - last_switch_).toSec() <= kRecentS;
-    const bool warn =
-        !recent.empty() || recent_switch || exceptions > 0 || no_target || no_info;
+    const bool warn = !recent.empty() || exceptions > 0 || no_target || no_info;
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
-                   : recent_switch        ? "image stream mixes cameras"
                    : !recent.empty()      ? recent
                    : no_info               ? std::string("images but no usable camera_info")
                    : no_target            ? "no start-up target: " + front_.targetReason()
@@ -252,12 +242,10 @@ class TrackerNodelet : public nodelet::Nodelet {
 
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // front_ and the log throttles
-  std::map<std::string, ros::WallTime> last_warned_;
 
   RecentEvents problems_;  // dropped images, unusable camera_info
   static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
-  long reported_switches_ = 0;
-  ros::WallTime last_switch_;
+  RecentEvents logged_;    // the front end's warnings: one throttle per kind
 
   NodeletDiagnostics diagnostics_;
 };
