@@ -6,7 +6,8 @@
 #   make bench   the benchmark suite and end-to-end latency (figures, never pass/fail)
 #   make eval    the plane core vs sequential MAGSAC on the AdelaideRMF dev scenes (DATA=folder)
 #   make eval-euroc  the plane core on the EuRoC stereo pairs vs their known pose (EUROC=folder)
-#   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan)
+#   make sanitize  the unit tests built with AddressSanitizer + UBSan (build/ws_asan;
+#                SANITIZE_ALL=1 also the long scene runs the short set leaves out)
 #   make helgrind  data-race check: the nodelets' rostests under helgrind
 #   make fuzz    libFuzzer targets of test/fuzz, FUZZ_SECONDS each (default 60)
 #   make clean   remove build/
@@ -84,7 +85,13 @@ fuzz: deps link
 
 test: build
 	@rm -rf $(WS)/build/test_results
-	@$(CATKIN) run_tests -j1 > $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
+	@# The test programs first, JOBS at a time (run_tests -j1 would build them one by one);
+	@# the gtests JOBS at a time too (no ROS master, nothing timed); the rostests one by one
+	@# (each replays images in real time through a manager and must keep up).
+	@$(CATKIN) tests > $(WS)/build_tests.log 2>&1 || { tail -40 $(WS)/build_tests.log; exit 1; }
+	@$(CATKIN) run_tests_mono_plane_detection_gtest > $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
+	@$(CATKIN) run_tests_mono_plane_detection_rostest run_tests_mono_plane_detection_roslaunch-check -j1 \
+	  >> $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
 	@scripts/summarize_tests.sh $(WS)/build/test_results
 
 # The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
@@ -108,7 +115,8 @@ eval-euroc: build
 	  --plane-pair $(WS)/devel/lib/mono_plane_detection/plane_pair
 
 # Same sources, a second workspace with sanitizers (-O1 -g1: the sanitizers' usual level,
-# line numbers in reports, quicker to compile than -O2 -g). It builds and runs the gtests
+# line numbers in reports, quicker to compile than -O2 -g; the test programs' own files
+# -O0, half the compile time of instrumented -O1). It builds and runs the gtests
 # that need no ROS master, JOBS at a time (scripts/run_sanitized.sh); those CMakeLists.txt
 # hosts in a rostest (add_rostest_gtest) stay in `make test`. Any report fails the run.
 ASAN_WS := $(REPO)/build/ws_asan
@@ -119,9 +127,9 @@ sanitize: deps
 	@$(MAKE) --no-print-directory link
 	@cd $(ASAN_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
+	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DMPD_TEST_COMPILE_OPTIONS=-O0 mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
 	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
-	@scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
+	@SANITIZE_ALL=$(SANITIZE_ALL) scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
 
 clean:
 	rm -rf build
