@@ -15,6 +15,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <deque>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -46,6 +47,10 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
   return tf;
 }
 
+std::string sizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
 }  // namespace
 
 class PlaneNodelet : public nodelet::Nodelet {
@@ -58,6 +63,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(connect_mutex_);
     diagnostics_.stop();
     tracks_sub_.shutdown();
+    retry_timer_.stop();
     info_sub_.shutdown();
     image_sub_.shutdown();
     static_sub_.shutdown();
@@ -131,6 +137,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose, guard_,
                        node.expected_min_rate_hz, node.expected_max_rate_hz);
 
+    retry_timer_ = nh.createWallTimer(ros::WallDuration(kRetryS),
+                                      guard_.wrap("odometry wait", [this](const auto&) { drain(); }),
+                                      true /* oneshot */, false /* autostart */);
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens).
     tracks_sub_ =
@@ -256,15 +265,19 @@ class PlaneNodelet : public nodelet::Nodelet {
       } else if (!planes) {
         res.message = "no map yet";
       } else {
-        std::ofstream out(req.path);
+        // A relative path is relative to the manager's working directory (ROS_HOME,
+        // ~/.ros, under roslaunch), not the caller's: the answer names the whole path.
+        std::error_code error;
+        const std::filesystem::path path = std::filesystem::absolute(req.path, error);
+        std::ofstream out(error ? std::filesystem::path(req.path) : path);
         out << planesYaml(*planes);
         out.close();
         if (!out) {
-          res.message = "cannot write " + req.path;
+          res.message = "cannot write " + path.string();
         } else {
           res.success = true;
           for (const auto& p : planes->planes) res.planes += p.metric;
-          res.message = "wrote " + std::to_string(res.planes) + " planes to " + req.path;
+          res.message = "wrote " + std::to_string(res.planes) + " planes to " + path.string();
         }
       }
       if (res.success)
@@ -278,8 +291,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::optional<Pose> odometry(const std_msgs::Header& header) {
     if (odom_frame_.empty()) return {};
     try {
-      // Never wait in a callback: take what tf has for this stamp or go visual.
+      // Never wait in a callback: drain() waited (odom_wait_s) without blocking; now
+      // take what tf has for this stamp or go visual.
       const auto tf = tf_buffer_->lookupTransform(odom_frame_, header.frame_id, header.stamp);
+      odometry_live_ = true;  // (drain_mutex_ held) the next tracks wait for it again
       const Pose odom = fromTransformMsg(tf.transform);
       // tf2 rejects NaN but not infinity; a driver glitch can also jump far in one step.
       std::lock_guard<std::mutex> lock(mutex_);
@@ -402,9 +417,54 @@ class PlaneNodelet : public nodelet::Nodelet {
     return toTransform(parent_from_child, header.stamp, parent, child);
   }
 
+  // Tracks wait (in order, without blocking a callback) until tf has the odometry at
+  // their stamp: a robot's odometry often lags its camera by a period. tf2_ros's
+  // MessageFilter waits too, but has no time bound (an image waited until the queue
+  // overflowed: the last image before odometry stops was never answered) and hands
+  // messages to the manager's worker threads in any order (the map starts over when
+  // time goes backwards).
   void onTracks(const TracksConstPtr& msg) {
-    const ros::WallTime started = ros::WallTime::now();
     diagnostics_.tick();
+    {
+      std::lock_guard<std::mutex> lock(pending_mutex_);
+      pending_.push_back({msg, ros::WallTime::now()});
+    }
+    drain();
+  }
+
+  void drain() {
+    std::lock_guard<std::mutex> order(drain_mutex_);  // one image at a time, oldest first
+    for (;;) {
+      TracksConstPtr msg;
+      ros::WallTime arrived;
+      size_t waiting = 0;
+      {
+        std::lock_guard<std::mutex> lock(pending_mutex_);
+        if (pending_.empty()) return;
+        std::tie(msg, arrived) = pending_.front();
+        waiting = pending_.size();
+      }
+      if (!odom_frame_.empty() && node_.odom_wait_s > 0 && odometry_live_ &&
+          !msg->header.frame_id.empty() && waiting < kMaxPending &&
+          !tf_buffer_->canTransform(odom_frame_, msg->header.frame_id, msg->header.stamp)) {
+        if ((ros::WallTime::now() - arrived).toSec() < node_.odom_wait_s) {
+          retry_timer_.stop();  // look again shortly (tf has no "arrived" event per stamp)
+          retry_timer_.setPeriod(ros::WallDuration(kRetryS));
+          retry_timer_.start();
+          return;
+        }
+        odometry_live_ = false;  // waited in vain: the next tracks do not wait for it
+      }
+      {
+        std::lock_guard<std::mutex> lock(pending_mutex_);
+        pending_.pop_front();
+      }
+      process(msg);
+    }
+  }
+
+  void process(const TracksConstPtr& msg) {
+    const ros::WallTime started = ros::WallTime::now();
     std::string error;
     TrackFrame frame = toTrackFrame(*msg, error);
     if (!error.empty()) {
@@ -428,12 +488,14 @@ class PlaneNodelet : public nodelet::Nodelet {
                                msg->header.frame_id != last_frame_id_;
       if (!last_tracks_size_.empty() && (other_frame || frame.size != last_tracks_size_)) {
         ++camera_switches_;
-        NODELET_WARN_THROTTLE(5.0,
-                              "tracks changed camera ('%s' %dx%d -> '%s' %dx%d): one camera "
-                              "per tracks topic, or the planes of neither are found",
-                              last_frame_id_.c_str(), last_tracks_size_.width,
-                              last_tracks_size_.height, msg->header.frame_id.c_str(),
-                              frame.size.width, frame.size.height);
+        // A recent problem, not a state: the diagnostics are OK again a while after the
+        // last switch (the total stays).
+        const std::string why = "tracks changed camera ('" + last_frame_id_ + "' " +
+                                sizeText(last_tracks_size_) + " -> '" + msg->header.frame_id +
+                                "' " + sizeText(frame.size) + ")";
+        if (problems_.note("tracks camera switch", "tracks mix cameras: " + why))
+          NODELET_WARN("%s: one camera per tracks topic, or the planes of neither are found",
+                       why.c_str());
       }
       if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
       last_tracks_size_ = frame.size;
@@ -571,8 +633,6 @@ class PlaneNodelet : public nodelet::Nodelet {
                          std::to_string(static_cast<int>(waited_s_)) + " s");
     else if (exceptions > 0)
       status.summary(DiagnosticStatus::WARN, "exceptions caught");
-    else if (camera_switches_ > 0)
-      status.summary(DiagnosticStatus::WARN, "tracks mix cameras");
     else if (const std::string recent = problems_.recent(kRecentS); !recent.empty())
       status.summary(DiagnosticStatus::WARN, recent);  // while recent; the totals stay below
     else
@@ -612,6 +672,12 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_, static_sub_;
+  ros::WallTimer retry_timer_;  // drain() again while tracks wait for odometry
+  std::mutex pending_mutex_, drain_mutex_;
+  std::deque<std::pair<TracksConstPtr, ros::WallTime>> pending_;  // arrival (wall) time
+  bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain
+  static constexpr double kRetryS = 0.005;
+  static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   mutable std::mutex static_mutex_;
   std::map<std::string, std::string> static_parents_;  // child -> parent on /tf_static
   ros::ServiceServer reset_srv_, save_srv_;

@@ -446,6 +446,10 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
     t.push_back({"max_odom_jump_m", field(&P::max_odom_jump_m), 1e-3, 1e6, "m",
                  "an odometry move larger than this between two tracks messages is refused "
                  "(the visual pose is used)"});
+    t.push_back({"odom_wait_s", field(&P::odom_wait_s), 0, 1, "s",
+                 "with odom_frame: how long tracks wait (wall time) for odometry at their "
+                 "stamp; after one wait in vain the next tracks do not wait until odometry "
+                 "is back (0: never wait)"});
     t.push_back({"expected_min_rate_hz", field(&P::expected_min_rate_hz), 0, 1e6, "Hz",
                  "diagnostics: a tracks rate below this is a warning"});
     t.push_back({"expected_max_rate_hz", field(&P::expected_max_rate_hz), 0, 1e6, "Hz",
@@ -611,8 +615,31 @@ static void checkMetricSource(PlaneNodeParams& p, std::vector<std::string>& erro
         "pose/metric_source camera_height needs pose/camera_height_m > 0: no metres until set");
 }
 
+// tf frame names the table cannot check: tf2 refuses a leading '/', an empty map frame
+// would put the map on tf as "" and a map frame equal to the odometry or camera frame
+// would make a link from a frame to itself.
+static void checkFrames(PlaneNodeParams& p, std::vector<std::string>& errors) {
+  for (std::string* frame : {&p.map_frame, &p.odom_frame, &p.camera_frame})
+    if (!frame->empty() && frame->front() == '/') {
+      errors.push_back("frame '" + *frame + "' starts with '/', which tf2 refuses; using '" +
+                       frame->substr(1) + "'");
+      frame->erase(0, 1);
+    }
+  const PlaneNodeParams d;
+  if (p.map_frame.empty() || p.map_frame == p.odom_frame || p.map_frame == p.camera_frame) {
+    errors.push_back("map_frame = '" + p.map_frame + "' " +
+                     (p.map_frame.empty() ? std::string("is empty")
+                                          : "is also the " + std::string(p.map_frame == p.odom_frame
+                                                                             ? "odom_frame"
+                                                                             : "camera_frame")) +
+                     "; using '" + d.map_frame + "'");
+    p.map_frame = d.map_frame;
+  }
+}
+
 std::vector<std::string> validate(PlaneNodeParams& params) {
   auto errors = validate(params, planeNodeParamTable());
+  checkFrames(params, errors);
   checkRateWindow(params, errors);
   checkTargetNames(params.pipeline.target, errors);
   checkMetricSource(params, errors);

@@ -19,6 +19,7 @@
 #include <std_srvs/Empty.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -688,6 +689,17 @@ TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
   EXPECT_NE(text.str().find("frame_id: plane_map"), std::string::npos);
   EXPECT_NE(text.str().find("label: floor"), std::string::npos);
   EXPECT_NE(text.str().find("label: wall"), std::string::npos);
+  // A relative path: the manager's working directory, not ours; the answer says where.
+  SaveMap relative;
+  relative.request.path = "plane_nodelet_map_" + std::to_string(getpid()) + ".yaml";
+  ASSERT_TRUE(ros::service::call("/plane_detector/save_map", relative));
+  ASSERT_TRUE(relative.response.success) << relative.response.message;
+  const size_t to = relative.response.message.find(" to /");
+  ASSERT_NE(to, std::string::npos) << relative.response.message;
+  const std::string written = relative.response.message.substr(to + 4);
+  EXPECT_NE(written.find("/" + relative.request.path), std::string::npos) << written;
+  EXPECT_TRUE(std::ifstream(written).good()) << written;
+  std::remove(written.c_str());
   SaveMap nowhere;
   nowhere.request.path = "/nonexistent_dir/map.yaml";
   ASSERT_TRUE(ros::service::call("/plane_detector/save_map", nowhere));

@@ -108,6 +108,28 @@ TEST(ParamTable, ValidateNestedAndNodeParams) {
   EXPECT_EQ(p.expected_min_rate_hz, d.expected_min_rate_hz);
 }
 
+// The hostile new-user try: map_frame "" was taken and put on tf as a frame named "".
+TEST(ParamTable, FrameNamesTfWouldRefuseAreRepaired) {
+  PlaneNodeParams p;
+  p.map_frame = "";
+  auto errors = validate(p);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("map_frame = '' is empty"), std::string::npos) << errors[0];
+  EXPECT_EQ(p.map_frame, "plane_map");
+  p.odom_frame = "/odom";
+  p.map_frame = "odom";
+  errors = validate(p);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_NE(errors[0].find("'/odom' starts with '/'"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[1].find("is also the odom_frame"), std::string::npos) << errors[1];
+  EXPECT_EQ(p.odom_frame, "odom");
+  EXPECT_EQ(p.map_frame, "plane_map");
+  PlaneNodeParams ok;
+  ok.odom_frame = "odom";
+  ok.camera_frame = "camera_estimate";
+  EXPECT_TRUE(validate(ok).empty());
+}
+
 TEST(ParamTable, MarkdownHasOneRowPerParameter) {
   const std::string md = toMarkdown(trackerParamTable());
   size_t rows = 0;
