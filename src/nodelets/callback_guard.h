@@ -64,7 +64,7 @@ class CallbackGuard {
       }
       ROS_ERROR_STREAM_THROTTLE_NAMED(5.0, logger_, "exception in the " << callback
                                                                        << " callback (" << what
-                                                                       << "): message dropped, "
+                                                                       << "): this call dropped, "
                                                                           "state kept");
     } catch (...) {  // logging itself failed (out of memory): nothing more to do
     }

@@ -108,7 +108,20 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (!front_.params().lazy) return;
     const bool wanted = tracks_pub_.getNumSubscribers() > 0 || debug_pub_.getNumSubscribers() > 0;
     if (wanted && !image_sub_) {
-      subscribe();
+      // A transport that is not installed (image_transport: compressed on Debian 12)
+      // throws here, when the first listener comes: said once per listener as what it
+      // is, and kept in diagnostics (ERROR) until a subscription works.
+      std::string error;
+      try {
+        subscribe();
+      } catch (const std::exception& e) {
+        error = std::string("cannot subscribe to ") + getNodeHandle().resolveName("image") +
+                " with image_transport '" + front_.params().image_transport + "' (" + e.what() +
+                "): no tracks; install that transport or set image_transport: raw";
+        NODELET_ERROR("%s", error.c_str());
+      }
+      std::lock_guard<std::mutex> state_lock(state_mutex_);
+      subscribe_error_ = error;
     } else if (!wanted && image_sub_) {
       image_sub_.shutdown();
       info_sub_.shutdown();
@@ -188,6 +201,9 @@ class TrackerNodelet : public nodelet::Nodelet {
     // Drops and camera switches count for the level while recent: the totals stay below.
     const std::string recent = problems_.recent(kRecentS);
     const bool warn = !recent.empty() || exceptions > 0 || no_target || no_info;
+    if (!subscribe_error_.empty())
+      status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, subscribe_error_);
+    else
     status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
                         : diagnostic_msgs::DiagnosticStatus::OK,
                    exceptions > 0         ? "exceptions caught"
@@ -237,6 +253,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   image_transport::Publisher debug_pub_;
   ros::ServiceServer reset_srv_;
   ros::WallTime first_image_;  // wall: diagnostics must hold under sim time
+  std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
   static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <nodelet/NodeletList.h>
 #include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -530,6 +531,38 @@ TEST_F(TrackerNodeletTest, ImagesWithoutCameraInfoAreAWarning) {
 // subscribed at once with lazy: false) is refused by the manager, and the manager and
 // its other nodelets go on. It used to take the whole manager down (segfault: its
 // diagnostics timer and publishers were destroyed after the nodelet's callback queue).
+// The hostile new-user try: with lazy subscription the missing transport showed only
+// when a listener came, as "exception in the connect callback: message dropped", then
+// nothing. Now an ERROR that names the transport, and diagnostics say it until fixed.
+TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
+  ros::param::set("/tracker_lazy_no_transport/image_transport", "no_such_transport");
+  nodelet::NodeletLoad load;
+  load.request.name = "/tracker_lazy_no_transport";
+  load.request.type = "mono_plane_detection/TrackerNodelet";
+  load.request.remap_source_args = {"tracks", "image"};
+  load.request.remap_target_args = {"tracks_lazy_no_transport", "image_lazy_no_transport"};
+  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load) && load.response.success);
+  DiagnosticsProbe diagnostics(nh_, "tracker_lazy_no_transport: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::OK) << diagnostics.message();
+  {
+    ros::Subscriber listener = nh_.subscribe<Tracks>(
+        "/tracks_lazy_no_transport", 1,
+        boost::function<void(const TracksConstPtr&)>([](const TracksConstPtr&) {}));
+    spinUntil([&] { return listener.getNumPublishers() > 0; }, 10.0);
+    ASSERT_TRUE(diagnostics.waitFresh());
+    ASSERT_TRUE(diagnostics.waitFresh());
+    EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR);
+    EXPECT_NE(diagnostics.message().find("image_transport 'no_such_transport'"),
+              std::string::npos)
+        << diagnostics.message();
+    EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
+  }
+  nodelet::NodeletUnload unload;
+  unload.request.name = "/tracker_lazy_no_transport";
+  EXPECT_TRUE(ros::service::call("/manager/unload_nodelet", unload) && unload.response.success);
+}
+
 TEST_F(TrackerNodeletTest, AFailedStartLeavesTheManagerRunning) {
   ros::param::set("/tracker_no_transport/image_transport", "no_such_transport");
   ros::param::set("/tracker_no_transport/lazy", false);
