@@ -47,6 +47,11 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
   return tf;
 }
 
+// tf2 refuses frame ids with a leading '/' (ROS 1 drivers of the tf1 era still send them).
+std::string tfFrame(const std::string& frame_id) {
+  return frame_id.rfind('/', 0) == 0 ? frame_id.substr(1) : frame_id;
+}
+
 std::string sizeText(const cv::Size& size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
@@ -269,15 +274,16 @@ class PlaneNodelet : public nodelet::Nodelet {
         // ~/.ros, under roslaunch), not the caller's: the answer names the whole path.
         std::error_code error;
         const std::filesystem::path path = std::filesystem::absolute(req.path, error);
-        std::ofstream out(error ? std::filesystem::path(req.path) : path);
+        const std::filesystem::path target = error ? std::filesystem::path(req.path) : path;
+        std::ofstream out(target);
         out << planesYaml(*planes);
         out.close();
         if (!out) {
-          res.message = "cannot write " + path.string();
+          res.message = "cannot write " + target.string();
         } else {
           res.success = true;
           for (const auto& p : planes->planes) res.planes += p.metric;
-          res.message = "wrote " + std::to_string(res.planes) + " planes to " + path.string();
+          res.message = "wrote " + std::to_string(res.planes) + " planes to " + target.string();
         }
       }
       if (res.success)
@@ -293,8 +299,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     try {
       // Never wait in a callback: drain() waited (odom_wait_s) without blocking; now
       // take what tf has for this stamp or go visual.
-      const auto tf = tf_buffer_->lookupTransform(odom_frame_, header.frame_id, header.stamp);
-      odometry_live_ = true;  // (drain_mutex_ held) the next tracks wait for it again
+      const auto tf = tf_buffer_->lookupTransform(odom_frame_, tfFrame(header.frame_id), header.stamp);
       const Pose odom = fromTransformMsg(tf.transform);
       // tf2 rejects NaN but not infinity; a driver glitch can also jump far in one step.
       std::lock_guard<std::mutex> lock(mutex_);
@@ -403,7 +408,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       // Never the camera's own frame: the robot's URDF is its parent already.
       parent = map_frame_;
-      child = camera_frame_.empty() ? header.frame_id + "_estimate" : camera_frame_;
+      child = camera_frame_.empty() ? tfFrame(header.frame_id) + "_estimate" : camera_frame_;
       parent_from_child = ros_map_from_camera;
     }
     tf_conflict_ = tfConflict(parent, child);
@@ -418,11 +423,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   // Tracks wait (in order, without blocking a callback) until tf has the odometry at
-  // their stamp: a robot's odometry often lags its camera by a period. tf2_ros's
-  // MessageFilter waits too, but has no time bound (an image waited until the queue
-  // overflowed: the last image before odometry stops was never answered) and hands
-  // messages to the manager's worker threads in any order (the map starts over when
-  // time goes backwards).
+  // their stamp: a robot's odometry often reaches tf a period after the image. tf2_ros's
+  // MessageFilter waits too, but without a time bound: an image waits until its queue
+  // overflows, so with odometry stopped every image is answered a queue length late and
+  // the last one before a pause never. All of this runs on the nodelet's single-threaded
+  // queue (getNodeHandle), tracks and retry timer alike; the mutexes only keep it safe.
   void onTracks(const TracksConstPtr& msg) {
     diagnostics_.tick();
     {
@@ -444,22 +449,30 @@ class PlaneNodelet : public nodelet::Nodelet {
         std::tie(msg, arrived) = pending_.front();
         waiting = pending_.size();
       }
-      if (!odom_frame_.empty() && node_.odom_wait_s > 0 && odometry_live_ &&
-          !msg->header.frame_id.empty() && waiting < kMaxPending &&
-          !tf_buffer_->canTransform(odom_frame_, msg->header.frame_id, msg->header.stamp)) {
-        if ((ros::WallTime::now() - arrived).toSec() < node_.odom_wait_s) {
-          retry_timer_.stop();  // look again shortly (tf has no "arrived" event per stamp)
-          retry_timer_.setPeriod(ros::WallDuration(kRetryS));
-          retry_timer_.start();
-          return;
+      const std::string frame = tfFrame(msg->header.frame_id);
+      if (!odom_frame_.empty() && node_.odom_wait_s > 0 && !frame.empty()) {
+        // tf has caught up with the image that waited in vain: the odometry lags more
+        // than odom_wait_s now and then, it has not stopped. Wait for it again.
+        if (!odometry_live_ && tf_buffer_->canTransform(odom_frame_, missed_frame_, missed_stamp_))
+          odometry_live_ = true;
+        if (odometry_live_ && waiting < kMaxPending &&
+            !tf_buffer_->canTransform(odom_frame_, frame, msg->header.stamp)) {
+          if ((ros::WallTime::now() - arrived).toSec() < node_.odom_wait_s) {
+            retry_timer_.stop();  // look again shortly (tf has no event per stamp)
+            retry_timer_.setPeriod(ros::WallDuration(kRetryS));
+            retry_timer_.start();
+            return;
+          }
+          odometry_live_ = false;  // waited in vain: the next tracks do not wait...
+          missed_frame_ = frame;   // ...until tf reaches this stamp
+          missed_stamp_ = msg->header.stamp;
         }
-        odometry_live_ = false;  // waited in vain: the next tracks do not wait for it
       }
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
         pending_.pop_front();
       }
-      process(msg);
+      guard_.run("tracks", [&] { process(msg); });  // one bad message never stalls the rest
     }
   }
 
@@ -675,7 +688,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::WallTimer retry_timer_;  // drain() again while tracks wait for odometry
   std::mutex pending_mutex_, drain_mutex_;
   std::deque<std::pair<TracksConstPtr, ros::WallTime>> pending_;  // arrival (wall) time
-  bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain
+  bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain...
+  std::string missed_frame_;    // ...for the odometry of this image
+  ros::Time missed_stamp_;
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   mutable std::mutex static_mutex_;

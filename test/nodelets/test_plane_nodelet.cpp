@@ -84,11 +84,12 @@ class PlaneNodeletTest : public ::testing::Test {
     image_planes_sub_ =
         nh_.subscribe("image_planes", 50, &PlaneNodeletTest::onImagePlanes, this);
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
-    // Both nodelets live in one manager process: one connection.
+    // Every topic is a connection of its own: an answer published before its subscriber
+    // is linked is lost (A_ missed its image_planes once in CI).
     spinUntil(
         [&] {
           return tracks_pub_.getNumSubscribers() > 0 && planes_sub_.getNumPublishers() > 0 &&
-                 no_info_sub_.getNumPublishers() > 0;
+                 image_planes_sub_.getNumPublishers() > 0 && no_info_sub_.getNumPublishers() > 0;
         },
         20.0);
     ASSERT_GT(tracks_pub_.getNumSubscribers(), 0u) << "plane nodelets never subscribed";
@@ -480,6 +481,12 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
     TrackFrame f = world_->frame(t);
     for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;  // no target
     f.stamp += 3500;  // its own time line
+    TracksPtr msg = toTracks(f);
+    msg->header.frame_id = "camera_optical_source";
+    tracks.publish(msg);
+    // The odometry lags the camera (tf 20 ms after the tracks, as on many robots): the
+    // nodelet waits for it. After the pause it must wait for it again (it did not: one
+    // wait in vain left every later image without odometry).
     const bool tf_stopped = k >= 70 && k < 100;
     if (!tf_stopped) {
       geometry_msgs::TransformStamped tf;
@@ -487,12 +494,9 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
       tf.header.frame_id = "odom_source";
       tf.child_frame_id = "camera_optical_source";  // a camera of its own: one parent each
       tf.transform = toTransformMsg(rosMapFromTarget() * world_->truthMapFromCamera(t));
+      ros::WallDuration(0.02).sleep();
       broadcaster.sendTransform(tf);
-      ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
     }
-    TracksPtr msg = toTracks(f);
-    msg->header.frame_id = "camera_optical_source";
-    tracks.publish(msg);
     const PlaneArrayConstPtr last = waitFor(answers, ros::Time(f.stamp).toNSec());
     ASSERT_TRUE(last) << "image " << k;
     ASSERT_TRUE(last->metric) << "image " << k << ": " << last->status;
@@ -513,8 +517,8 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
           << diagnostics.message();
       EXPECT_EQ(diagnostics.value("metric source"), "odometry");
     }
-    if (k == 119) {
-      EXPECT_EQ(last->status, "tracking (odometry)");
+    if (k >= 102) {  // the first image after the pause goes without (nobody waits yet)
+      EXPECT_EQ(last->status, "tracking (odometry)") << "image " << k;
     }
   }
   EXPECT_LT(worst_step, 0.05);  // 0.01 m per image
@@ -660,6 +664,10 @@ TEST_F(PlaneNodeletTest, M_TwoCamerasOnOneTracksTopicAreReported) {
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_GE(diagnostics.number("camera switches (total)") - before, 9);
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  // While recent (10 s), named; the level is not stuck at WARN for good any more.
+  EXPECT_NE(diagnostics.message().find("tracks mix cameras: tracks changed camera"),
+            std::string::npos)
+      << diagnostics.message();
   EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
 }
 

@@ -527,10 +527,6 @@ TEST_F(TrackerNodeletTest, ImagesWithoutCameraInfoAreAWarning) {
   EXPECT_EQ(diagnostics.value("camera_info"), "none or unusable");
 }
 
-// A tracker whose start throws (an image_transport plugin that is not installed,
-// subscribed at once with lazy: false) is refused by the manager, and the manager and
-// its other nodelets go on. It used to take the whole manager down (segfault: its
-// diagnostics timer and publishers were destroyed after the nodelet's callback queue).
 // The hostile new-user try: with lazy subscription the missing transport showed only
 // when a listener came, as "exception in the connect callback: message dropped", then
 // nothing. Now an ERROR that names the transport, and diagnostics say it until fixed.
@@ -563,6 +559,10 @@ TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
   EXPECT_TRUE(ros::service::call("/manager/unload_nodelet", unload) && unload.response.success);
 }
 
+// A tracker whose start throws (an image_transport plugin that is not installed,
+// subscribed at once with lazy: false) is refused by the manager, and the manager and
+// its other nodelets go on. It used to take the whole manager down (segfault: its
+// diagnostics timer and publishers were destroyed after the nodelet's callback queue).
 TEST_F(TrackerNodeletTest, AFailedStartLeavesTheManagerRunning) {
   ros::param::set("/tracker_no_transport/image_transport", "no_such_transport");
   ros::param::set("/tracker_no_transport/lazy", false);

@@ -7,8 +7,11 @@
 #include <sstream>
 #include <string>
 
+#include "support/temp_path.h"
+
 TEST(DownstreamBuild, Gnu14PackageCompilesAgainstTheHeaders) {
-  const std::string dir = ::testing::TempDir() + "mpd_downstream_build";
+  // Its own folder per run: make test and make sanitize (or two workspaces) run it at once.
+  const std::string dir = mono_plane_detection::tempPath("downstream_build");
   const std::string log = dir + ".log";
   // The outer make's MAKEFLAGS (make test) must not reach this build.
   const std::string command = "rm -rf '" + dir + "' && mkdir -p '" + dir + "' && cd '" + dir +
@@ -31,4 +34,5 @@ TEST(DownstreamBuild, Gnu14PackageCompilesAgainstTheHeaders) {
   const size_t gnu14 = out.find("-std=gnu++14"), cxx17 = out.find("++17", gnu14);
   EXPECT_NE(gnu14, std::string::npos) << out;
   EXPECT_NE(cxx17, std::string::npos) << out;
+  EXPECT_EQ(std::system(("rm -rf '" + dir + "' '" + log + "'").c_str()), 0);
 }
