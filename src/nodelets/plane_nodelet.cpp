@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <cerrno>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -242,6 +243,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
     bool done = false;
     guard_.run("reset", [&] {
+      {
+        std::lock_guard<std::mutex> order(drain_mutex_);  // (drain_mutex_ before mutex_)
+        odometry_live_ = true;  // the odometry is waited for again
+      }
       std::lock_guard<std::mutex> lock(mutex_);
       pipeline_->reset();
       markers_shown_.clear();
@@ -279,7 +284,8 @@ class PlaneNodelet : public nodelet::Nodelet {
         out << planesYaml(*planes);
         out.close();
         if (!out) {
-          res.message = "cannot write " + target.string();
+          res.message = "cannot write " + target.string() + " (" +
+                        std::error_code(errno, std::generic_category()).message() + ")";
         } else {
           res.success = true;
           for (const auto& p : planes->planes) res.planes += p.metric;
@@ -451,10 +457,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       const std::string frame = tfFrame(msg->header.frame_id);
       if (!odom_frame_.empty() && node_.odom_wait_s > 0 && !frame.empty()) {
-        // tf has caught up with the image that waited in vain: the odometry lags more
-        // than odom_wait_s now and then, it has not stopped. Wait for it again.
-        if (!odometry_live_ && tf_buffer_->canTransform(odom_frame_, missed_frame_, missed_stamp_))
-          odometry_live_ = true;
+        if (!odometry_live_ && odometryBack(frame, msg->header.stamp)) odometry_live_ = true;
         if (odometry_live_ && waiting < kMaxPending &&
             !tf_buffer_->canTransform(odom_frame_, frame, msg->header.stamp)) {
           if ((ros::WallTime::now() - arrived).toSec() < node_.odom_wait_s) {
@@ -464,8 +467,7 @@ class PlaneNodelet : public nodelet::Nodelet {
             return;
           }
           odometry_live_ = false;  // waited in vain: the next tracks do not wait...
-          missed_frame_ = frame;   // ...until tf reaches this stamp
-          missed_stamp_ = msg->header.stamp;
+          missed_stamp_ = msg->header.stamp;  // ...until tf's odometry passes this stamp
         }
       }
       {
@@ -473,6 +475,20 @@ class PlaneNodelet : public nodelet::Nodelet {
         pending_.pop_front();
       }
       guard_.run("tracks", [&] { process(msg); });  // one bad message never stalls the rest
+    }
+  }
+
+  // Odometry to wait for again: tf's newest odometry is past the stamp that waited in
+  // vain (it lags more than odom_wait_s now and then; a lookup at that stamp itself may
+  // never succeed once tf has forgotten it, after 10 s), or time went backwards (a new
+  // stream, a bag loop).
+  bool odometryBack(const std::string& frame, const ros::Time& stamp) const {
+    if (stamp < missed_stamp_) return true;
+    try {
+      return tf_buffer_->lookupTransform(odom_frame_, frame, ros::Time(0)).header.stamp >
+             missed_stamp_;
+    } catch (const tf2::TransformException&) {
+      return false;
     }
   }
 
@@ -637,7 +653,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                                                  : "tracking lost: " + status_);
     else if (odometry_stopped_)
       status.summary(DiagnosticStatus::WARN,
-                     "odometry (" + odom_frame_ + ") stopped: camera pose from vision only");
+                     "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: "
+                     "camera pose from vision only");
     else if (target_late)
       status.summary(DiagnosticStatus::WARN,
                      (node_.pipeline.pose.metric_source == "target"
@@ -689,8 +706,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::mutex pending_mutex_, drain_mutex_;
   std::deque<std::pair<TracksConstPtr, ros::WallTime>> pending_;  // arrival (wall) time
   bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain...
-  std::string missed_frame_;    // ...for the odometry of this image
-  ros::Time missed_stamp_;
+  ros::Time missed_stamp_;      // ...for the odometry of the image of this stamp
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   mutable std::mutex static_mutex_;

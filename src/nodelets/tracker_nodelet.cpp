@@ -115,8 +115,11 @@ class TrackerNodelet : public nodelet::Nodelet {
       try {
         subscribe();
       } catch (const std::exception& e) {
+        // pluginlib's text spans lines and lists every plugin: its first line says it.
+        std::string why = e.what();
+        why = why.substr(0, why.find('\n'));
         error = std::string("cannot subscribe to ") + getNodeHandle().resolveName("image") +
-                " with image_transport '" + front_.params().image_transport + "' (" + e.what() +
+                " with image_transport '" + front_.params().image_transport + "' (" + why +
                 "): no tracks; install that transport or set image_transport: raw";
         NODELET_ERROR("%s", error.c_str());
       }

@@ -163,7 +163,7 @@ struct PlaneNodeParams {
   double target_timeout_s = 30.0;
   std::string image_transport = "raw";
   double max_odom_jump_m = 1.0;
-  double odom_wait_s = 0.1;          // tracks wait this long for odometry at their stamp
+  double odom_wait_s = 0.25;         // tracks wait this long for odometry at their stamp
   double expected_min_rate_hz = 5.0;
   double expected_max_rate_hz = 100.0;
 };
