@@ -23,7 +23,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build demo test bench eval eval-euroc sanitize helgrind fuzz clean
+.PHONY: deps link build demo test bench eval eval-euroc sanitize sanitize-build helgrind fuzz clean
 
 deps:
 	@scripts/install_deps.sh
@@ -36,7 +36,10 @@ link:
 	@mkdir -p $(WS)/src
 	@[ ! -L $(PKG) ] || rm $(PKG)
 	@mkdir -p $(PKG)
-	@for f in $(REPO)/* $(REPO)/.ci; do [ "$$(basename $$f)" = build ] || ln -sfn $$f $(PKG)/; done
+	@# Only missing or wrong links are made: a build running meanwhile (CI's sanitizer build)
+	@# never sees a link that is being replaced.
+	@for f in $(REPO)/* $(REPO)/.ci; do [ "$$(basename $$f)" = build ] || \
+	  [ "$$(readlink $(PKG)/$$(basename $$f))" = "$$f" ] || ln -sfn $$f $(PKG)/; done
 
 build: deps link
 	@echo "build: catkin_make in $(WS) (log: $(WS)/build.log)"
@@ -122,14 +125,18 @@ eval-euroc: build
 ASAN_WS := $(REPO)/build/ws_asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 sanitize: deps
+	@$(MAKE) --no-print-directory link
+	@$(MAKE) --no-print-directory sanitize-build
+	@SANITIZE_ALL=$(SANITIZE_ALL) scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
+
+# The sanitizer workspace's build alone (after make build: deps and links in place).
+sanitize-build:
 	@mkdir -p $(ASAN_WS)/src
 	@[ -e $(ASAN_WS)/src/mono_plane_detection ] || ln -sfn $(PKG) $(ASAN_WS)/src/mono_plane_detection
-	@$(MAKE) --no-print-directory link
 	@cd $(ASAN_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
 	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DMPD_TEST_COMPILE_OPTIONS=-O0 mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
 	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
-	@SANITIZE_ALL=$(SANITIZE_ALL) scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
 
 clean:
 	rm -rf build
