@@ -32,6 +32,12 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
     trim(now);
   }
 
+  // A lazy nodelet nobody listens to subscribes to nothing: no input is then expected.
+  void setIdle(bool idle) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    idle_ = idle;
+  }
+
   void run(diagnostic_updater::DiagnosticStatusWrapper& status) override {
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::WallTime now = ros::WallTime::now();
@@ -40,7 +46,10 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
     const double span =
         started_.isZero() ? window_s_ : std::min(window_s_, std::max((now - started_).toSec(), 1e-3));
     const double hz = static_cast<double>(ticks_.size()) / span;
-    if (total_ == 0)
+    if (idle_)
+      status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                     "idle: nobody listens, nothing subscribed (lazy)");
+    else if (total_ == 0)
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input yet");
     else if (ticks_.empty())
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input for the last window");
@@ -68,6 +77,7 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
   std::deque<ros::WallTime> ticks_;
   ros::WallTime started_;
   long total_ = 0;
+  bool idle_ = false;
 };
 
 class NodeletDiagnostics {
@@ -91,6 +101,10 @@ class NodeletDiagnostics {
 
   void tick() {
     if (rate_) rate_->tick();
+  }
+
+  void setIdle(bool idle) {
+    if (rate_) rate_->setIdle(idle);
   }
 
   // Stops the timer and drops the updater now, while the nodelet's callback queue lives

@@ -567,9 +567,10 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       if (result.tracking_loss)
         NODELET_WARN_THROTTLE(5.0,
-                              "%.1f s without tracks: tracking lost, waiting for the map "
-                              "or the target to place the camera again",
-                              params_.max_gap_s);
+                              "%.1f s without tracks: tracking lost, waiting for %s to place "
+                              "the camera again",
+                              params_.max_gap_s,
+                              odom_frame_.empty() ? "the map or the target" : "the odometry");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;

@@ -66,6 +66,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     tracks_pub_ = nh.advertise<Tracks>("tracks", 10, connect, connect);
     debug_pub_ = it_->advertise("debug_image", 1, connect, connect);
     if (!front_.params().lazy) subscribe();
+    diagnostics_.setIdle(front_.params().lazy);  // until a listener comes
     reset_srv_ = pnh.advertiseService("reset", &TrackerNodelet::onReset, this);
   }
 
@@ -107,6 +108,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(connect_mutex_);
     if (!front_.params().lazy) return;
     const bool wanted = tracks_pub_.getNumSubscribers() > 0 || debug_pub_.getNumSubscribers() > 0;
+    diagnostics_.setIdle(!wanted);
     if (wanted && !image_sub_) {
       // A transport that is not installed (image_transport: compressed on Debian 12)
       // throws here, when the first listener comes: said once per listener as what it

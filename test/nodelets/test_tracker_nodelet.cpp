@@ -539,8 +539,13 @@ TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
   load.request.remap_target_args = {"tracks_lazy_no_transport", "image_lazy_no_transport"};
   ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load) && load.response.success);
   DiagnosticsProbe diagnostics(nh_, "tracker_lazy_no_transport: tracking");
+  DiagnosticsProbe rate(nh_, "tracker_lazy_no_transport: input rate");
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::OK) << diagnostics.message();
+  // Nobody listens: no input is expected (it was WARN "no input yet" on an idle robot).
+  ASSERT_TRUE(rate.waitFresh());
+  EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
+  EXPECT_EQ(rate.message().rfind("idle", 0), 0u) << rate.message();
   {
     ros::Subscriber listener = nh_.subscribe<Tracks>(
         "/tracks_lazy_no_transport", 1,
@@ -553,6 +558,8 @@ TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
               std::string::npos)
         << diagnostics.message();
     EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
+    ASSERT_TRUE(rate.waitFresh());  // someone listens and nothing comes: WARN
+    EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::WARN) << rate.message();
   }
   nodelet::NodeletUnload unload;
   unload.request.name = "/tracker_lazy_no_transport";
