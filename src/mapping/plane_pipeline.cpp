@@ -159,7 +159,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     // its floor, more of them than an image plane of the floor holds (the humanoid's: 30
     // and more against 5-10 after the turn, where 10 points mapped noise seed 7's floor
     // 1.92 deg off): the floor plane starts with them and is as level as the map.
-    if (pose_->checkedFloor().stamp == frame.stamp) {
+    if (pose_->checkedFloor().image == pose_->imageIndex()) {
       ImagePlane floor;
       floor.inlier_ids = pose_->checkedFloor().ids;
       const std::vector<PlaneObservation> known = observationsOf({floor}, *result.pose);

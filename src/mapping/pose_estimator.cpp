@@ -101,6 +101,7 @@ std::optional<cv::Vec3d> PoseEstimator::landmarkPosition(std::uint64_t id) const
 
 std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
                                                   const std::optional<Pose>& odom_from_camera) {
+  ++image_index_;
   checking_pose_.reset();
   if (frame.ids.empty()) return {};
   // The target's corners become fixed landmarks whenever all four are tracked under new
@@ -197,7 +198,7 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   if (params_.bundle_window > 0 && estimate->source != PoseSource::kOdometry && !vision_only_)
     bundleAdjust(frame, normalized, *estimate);
   forgetOldLandmarks();
-  if (floor_check_ && !checkFloor(frame.stamp, *estimate, odom_from_camera)) {
+  if (floor_check_ && !checkFloor(*estimate, odom_from_camera)) {
     if (floor_check_ && floor_check_->unscaled) checking_pose_ = estimate;
     return {};
   }
@@ -222,7 +223,7 @@ void PoseEstimator::undoFloorStart(const std::string& why) {
   keyframes_.clear();
 }
 
-bool PoseEstimator::checkFloor(double stamp, PoseEstimate& estimate,
+bool PoseEstimator::checkFloor(PoseEstimate& estimate,
                                const std::optional<Pose>& odom_from_camera) {
   FloorCheck& check = *floor_check_;
   const FloorParams& p = params_.floor;
@@ -342,7 +343,7 @@ bool PoseEstimator::checkFloor(double stamp, PoseEstimate& estimate,
   correction_ = s;
   checked_floor_.ids.clear();
   for (int i : fit.inliers) checked_floor_.ids.push_back(ids[static_cast<size_t>(i)]);
-  checked_floor_.stamp = stamp;
+  checked_floor_.image = image_index_;
   if (odom_from_camera) map_from_odom_ = estimate.map_from_camera * odom_from_camera->inverse();
   floor_check_.reset();
   floor_reason_.clear();
@@ -410,7 +411,7 @@ std::optional<PoseEstimate> PoseEstimator::visualPose(const TrackFrame& frame,
             l.triangulated = false;
             l.anchor_pose = map_from_camera;
             l.anchor_normalized = normalized[index[k]];
-            l.anchor_stamp = frame.stamp;
+            l.anchor_image = image_index_;
             l.provisional = vision_only_;
           }
         }
@@ -540,7 +541,7 @@ void PoseEstimator::placeStartLandmarks(
     l.parallax_deg = parallax_deg;
     l.anchor_pose = map_from_second;
     l.anchor_normalized = second[points[k]];
-    l.anchor_stamp = frame.stamp;
+    l.anchor_image = image_index_;
     l.last_seen = frame.stamp;
   }
   initialised_ = true;
@@ -554,7 +555,7 @@ void PoseEstimator::placeStartLandmarks(
   keyframes_.clear();
   if (params_.bundle_window > 0) {
     keyframes_.push_back(Keyframe{-1, map_from_first, ids, first});
-    keyframes_.push_back(Keyframe{frame.stamp, map_from_second, frame.ids, normalized});
+    keyframes_.push_back(Keyframe{image_index_, map_from_second, frame.ids, normalized});
   }
 }
 
@@ -731,7 +732,7 @@ void PoseEstimator::triangulate(const TrackFrame& frame, const std::vector<cv::P
     if (is_new) {
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[i];
-      l.anchor_stamp = frame.stamp;
+      l.anchor_image = image_index_;
       l.last_seen = frame.stamp;
       l.provisional = vision_only_;
       continue;
@@ -769,7 +770,7 @@ void PoseEstimator::restartProvisional(const TrackFrame& frame,
       l = Landmark();
       l.anchor_pose = map_from_camera;
       l.anchor_normalized = normalized[seen->second];
-      l.anchor_stamp = frame.stamp;
+      l.anchor_image = image_index_;
       l.last_seen = frame.stamp;
       ++it;
     }

@@ -28,7 +28,7 @@ bool PoseEstimator::addKeyframe(const TrackFrame& frame, const std::vector<cv::P
     constexpr double kKeyframeMotion = 0.02;
     if (moved.size() * 2 >= last.ids.size() && median(moved) < kKeyframeMotion) return false;
   }
-  keyframes_.push_back(Keyframe{frame.stamp, estimate.map_from_camera, frame.ids, normalized});
+  keyframes_.push_back(Keyframe{image_index_, estimate.map_from_camera, frame.ids, normalized});
   // The window's landmarks are also held by as many keyframes before it (fixed views, as
   // ORB-SLAM's local mapping). With only their first view fixed, every window moved them
   // along that ray again long after they were mapped (humanoid target: the front wall's
@@ -57,7 +57,7 @@ PoseEstimator::WindowProblem PoseEstimator::windowProblem() const {
   BundleProblem& problem = w.problem;
   for (size_t k = 0; k < keyframes_.size(); ++k) {
     problem.views.push_back({keyframes_[k].map_from_camera, k < w.first_free});
-    w.keyframe_of_stamp.emplace(keyframes_[k].stamp, static_cast<int>(k));
+    w.keyframe_of_image.emplace(keyframes_[k].image, static_cast<int>(k));
   }
   // The points: every landmark a keyframe of the window sees.
   std::unordered_map<std::uint64_t, int> point_of;
@@ -85,7 +85,7 @@ PoseEstimator::WindowProblem PoseEstimator::windowProblem() const {
   w.keyframe_observations = problem.observations.size();
   for (size_t j = 0; j < w.point_ids.size(); ++j) {
     const Landmark& l = landmarks_.at(w.point_ids[j]);
-    if (l.fixed || w.keyframe_of_stamp.count(l.anchor_stamp)) continue;
+    if (l.fixed || w.keyframe_of_image.count(l.anchor_image)) continue;
     problem.views.push_back({l.anchor_pose, true});
     problem.observations.push_back(
         {static_cast<int>(problem.views.size()) - 1, static_cast<int>(j), l.anchor_normalized});
@@ -99,15 +99,15 @@ PoseEstimator::WindowProblem PoseEstimator::windowProblem() const {
 }
 
 void PoseEstimator::applyWindow(const WindowProblem& w, const BundleResult& result,
-                                const TrackFrame& frame, PoseEstimate& estimate) {
+                                PoseEstimate& estimate) {
   const BundleProblem& problem = w.problem;
   for (size_t k = w.first_free; k < keyframes_.size(); ++k)
     keyframes_[k].map_from_camera = problem.views[k].map_from_camera;
   for (size_t j = 0; j < w.point_ids.size(); ++j) {
     Landmark& l = landmarks_.at(w.point_ids[j]);
     if (!l.fixed) l.position = problem.points[j].position;
-    const auto kf = w.keyframe_of_stamp.find(l.anchor_stamp);
-    if (kf != w.keyframe_of_stamp.end()) l.anchor_pose = keyframes_[kf->second].map_from_camera;
+    const auto kf = w.keyframe_of_image.find(l.anchor_image);
+    if (kf != w.keyframe_of_image.end()) l.anchor_pose = keyframes_[kf->second].map_from_camera;
   }
   // Observations the adjusted map disagrees with (beyond the Huber threshold: they had
   // little weight) no longer count: an older keyframe's is dropped from it; this
@@ -125,7 +125,7 @@ void PoseEstimator::applyWindow(const WindowProblem& w, const BundleResult& resu
       l.triangulated = false;
       l.anchor_pose = problem.views[newest].map_from_camera;
       l.anchor_normalized = b.normalized;
-      l.anchor_stamp = frame.stamp;
+      l.anchor_image = image_index_;
     } else {
       dropped[b.view].push_back(w.point_ids[b.point]);
     }
@@ -155,7 +155,7 @@ void PoseEstimator::bundleAdjust(const TrackFrame& frame,
   bundle_counts_.behind_after += result.behind_after;
   bundle_counts_.refused_behind += result.refused_behind;
   if (result.ok) {
-    applyWindow(w, result, frame, estimate);
+    applyWindow(w, result, estimate);
   } else {
     ++bundle_counts_.refused;
     bundle_counts_.last_reason = result.reason;

@@ -398,6 +398,47 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
   }
 }
 
+TEST(PoseEstimator, ImagesAreToldApartByTheirNumberNotTheirStamp) {
+  // A driver that stamps two images alike (here every pair): the keyframes, the
+  // landmarks' anchors and the checked floor are matched by the image's number.
+  const SyntheticTracks world("wheeled", 100);
+  PoseEstimator estimator(world.camera.K(), world.camera.distortion(),
+                          source("camera_height", 0.8));
+  EXPECT_EQ(estimator.imageIndex(), -1);
+  EXPECT_EQ(estimator.checkedFloor().image, -1);
+  int first_posed = -1;
+  for (int k = 0; k < 240; ++k) {
+    const double t = k / 30.0;
+    TrackFrame frame = withoutTarget(world.frame(t));
+    frame.stamp = 100.0 + (k / 2) * 2 / 30.0;  // images 2j and 2j + 1: one stamp
+    const auto e = estimator.update(frame);
+    EXPECT_EQ(estimator.imageIndex(), k);
+    if (!e) continue;
+    if (first_posed < 0) {
+      first_posed = k;
+      // The check passed on this very image, not on its twin.
+      EXPECT_EQ(estimator.checkedFloor().image, k);
+      EXPECT_FALSE(estimator.checkedFloor().ids.empty());
+    }
+  }
+  ASSERT_GE(first_posed, 0) << estimator.waitingFor();
+  EXPECT_EQ(estimator.checkedFloor().image, first_posed);  // not checked again
+  // The landmarks where the points are (the map's frame is the floor's: align first).
+  std::vector<cv::Vec3d> est, truth;
+  for (size_t i = 0; i < world.points.size(); ++i)
+    if (const auto x = estimator.landmarkPosition(100 + i)) {
+      est.push_back(*x);
+      truth.push_back(world.points[i]);
+    }
+  ASSERT_GT(est.size(), 300u);
+  const Pose world_from_map = rigidAlign(est, truth);
+  std::vector<double> errors;
+  for (size_t i = 0; i < est.size(); ++i)
+    errors.push_back(cv::norm(world_from_map.apply(est[i]) - truth[i]));
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.05);  // as with distinct stamps (0.009 m)
+}
+
 // The humanoid's synthetic tracks until its up-to-scale start has been checking the
 // floor for 5 images (no floor in the image at the start); the next image's index.
 namespace {

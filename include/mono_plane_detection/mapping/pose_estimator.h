@@ -59,7 +59,7 @@ struct Landmark {
   bool fixed = false;             // a target corner: position known exactly
   cv::Vec3d position;             // map frame, m (when triangulated or fixed)
   Pose anchor_pose;               // map_from_camera at the anchor observation
-  double anchor_stamp = -1;       // that image's stamp (a keyframe's, when it became one)
+  std::int64_t anchor_image = -1;  // that image's imageIndex() (a keyframe's, when it became one)
   cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
   double parallax_deg = 0;        // between the two rays of the triangulation
   double last_seen = 0;           // stamp, s
@@ -111,12 +111,15 @@ class PoseEstimator {
   // The similarity the last floor check applied to the map (identity before).
   const Similarity& floorCorrectionApplied() const { return correction_; }
   // camera_height: the landmarks the passed floor check fitted the floor to (ids) and
-  // the stamp of that image (-1 before).
+  // the imageIndex() of that image (-1 before).
   struct CheckedFloor {
     std::vector<std::uint64_t> ids;
-    double stamp = -1;
+    std::int64_t image = -1;
   };
   const CheckedFloor& checkedFloor() const { return checked_floor_; }
+  // How many images update() has been given, less one: the last image's number. Images
+  // are told apart by it, not by their stamps (a driver may stamp two images alike).
+  std::int64_t imageIndex() const { return image_index_; }
   // What the start waits for, for people ("waiting for target", ...).
   std::string waitingFor() const;
   // True once the two-view start has placed the first landmarks (before that the pose
@@ -171,14 +174,13 @@ class PoseEstimator {
     std::vector<std::uint64_t> point_ids;  // the landmark of each problem point
     size_t keyframe_observations = 0;      // the first ones: the keyframes' (then anchors')
     size_t first_in_window = 0, first_free = 0;  // keyframe indices
-    std::unordered_map<double, int> keyframe_of_stamp;
+    std::unordered_map<std::int64_t, int> keyframe_of_image;
   };
   bool addKeyframe(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                    const PoseEstimate& estimate);
   size_t bundleWindow() const;
   WindowProblem windowProblem() const;
-  void applyWindow(const WindowProblem& w, const BundleResult& result, const TrackFrame& frame,
-                   PoseEstimate& estimate);
+  void applyWindow(const WindowProblem& w, const BundleResult& result, PoseEstimate& estimate);
   bool allows(MetricSource source) const;
   void restartProvisional(const TrackFrame& frame, const std::vector<cv::Point2d>& normalized,
                           const Pose& map_from_camera);
@@ -186,7 +188,7 @@ class PoseEstimator {
   // camera_height: checks the start against the floor its landmarks show; true once the
   // map has been corrected (poses may be given out), false while waiting; undoes the
   // start when the floor disagrees.
-  bool checkFloor(double stamp, PoseEstimate& estimate,
+  bool checkFloor(PoseEstimate& estimate,
                   const std::optional<Pose>& odom_from_camera);
   void undoFloorStart(const std::string& why);
   // Tracks of this image with a landmark position (landmarkPosition).
@@ -245,11 +247,12 @@ class PoseEstimator {
   Similarity correction_;
   CheckedFloor checked_floor_;
   struct Keyframe {
-    double stamp = -1;
+    std::int64_t image = -1;  // imageIndex() (-1: the two-view start's first view)
     Pose map_from_camera;
     std::vector<std::uint64_t> ids;
     std::vector<cv::Point2d> normalized;
   };
+  std::int64_t image_index_ = -1;  // never reset: an index is not used twice
   std::deque<Keyframe> keyframes_;  // the window (newest bundle_window) and as many before it
   std::vector<double> bundle_times_ms_;
   BundleCounts bundle_counts_;
