@@ -119,14 +119,43 @@ void TrackerFrontEnd::reset() {
   target_startup_.reset();
   target_wait_start_ns_ = target_wait_last_ns_ = 0;
   target_waited_before_s_ = 0;
+  heard_ns_ = 0;
+  heard_frame_id_.clear();
   last_stamp_ns_ = 0;
   last_size_ = cv::Size();
   last_frame_id_.clear();
   gaps_.reset();
 }
 
+// Images missing from the stream are counted between messages heard, good or bad: an
+// image dropped here (a bad encoding, a wrong size) arrived and is counted as dropped;
+// counted as missing too, "missing" followed "dropped" through a stream's bad phases.
+// True when the interval since the last message heard is a pause.
+bool TrackerFrontEnd::hear(uint64_t stamp_ns, const std::string& frame_id) {
+  bool pause = false;
+  const bool other_camera =
+      !frame_id.empty() && !heard_frame_id_.empty() && frame_id != heard_frame_id_;
+  if (other_camera || stamp_ns < heard_ns_) {
+    gaps_.reset();  // another camera's or a new run's rhythm
+  } else if (heard_ns_ != 0 && stamp_ns > heard_ns_) {
+    const auto interval = static_cast<int64_t>(stamp_ns - heard_ns_);
+    pause = gaps_.isPause(interval, params_.max_gap_s);
+    if (pause)
+      gaps_.addPause(interval);
+    else
+      counts_.missing += gaps_.add(interval);
+  }
+  heard_ns_ = stamp_ns;
+  if (!frame_id.empty()) heard_frame_id_ = frame_id;
+  return pause;
+}
+
 TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   TrackerOutput out;
+  // Integer nanoseconds: (a - b) as a ros::Duration throws beyond 2^31 s (a driver with
+  // an uninitialised clock sends secs = 4000000000 after 1.7e9).
+  const uint64_t stamp_ns = msg->header.stamp.toNSec();
+  const bool heard_pause = hear(stamp_ns, msg->header.frame_id);
   out.grey = toGrey(msg);
   if (!out.grey.image) {
     ++counts_.dropped;
@@ -141,9 +170,6 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     out.dropped_is_error = true;
     return out;
   }
-  // Integer nanoseconds: (a - b) as a ros::Duration throws beyond 2^31 s (a driver with
-  // an uninitialised clock sends secs = 4000000000 after 1.7e9).
-  const uint64_t stamp_ns = msg->header.stamp.toNSec();
   if (last_stamp_ns_ != 0 && stamp_ns == last_stamp_ns_) {
     ++counts_.dropped;  // the same image twice (a republisher, a bag with duplicates)
     out.dropped = "its stamp " + seconds(stamp_ns) + " repeats the previous one";
@@ -176,7 +202,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     closeTargetWait();
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
-    if (gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s)) {
+    // Longer than the interval heard when images were dropped since the last one tracked.
+    if (heard_pause || gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s)) {
       // After a pause the scene may have moved anywhere: Lucas-Kanade would follow the
       // old points into the wrong places. The stream's rhythm stays (a low-rate camera
       // learns its period through its first pauses).
@@ -184,10 +211,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
                                                        "starting over"});
       tracker_.reset();
       target_startup_.reset();
-      gaps_.addPause(static_cast<int64_t>(gap_ns));
       closeTargetWait();
-    } else {
-      counts_.missing += gaps_.add(static_cast<int64_t>(gap_ns));
     }
   }
   if (msg->header.frame_id.empty())

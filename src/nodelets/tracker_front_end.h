@@ -77,7 +77,11 @@ class TrackerFrontEnd {
   TrackerNodeParams params_;
   FeatureTracker tracker_;
   TargetStartup target_startup_;
-  uint64_t last_stamp_ns_ = 0;  // 0: none yet
+  // Every message heard, also one dropped as bad: the stream's rhythm (hear()).
+  bool hear(uint64_t stamp_ns, const std::string& frame_id);
+  uint64_t heard_ns_ = 0;  // 0: none yet
+  std::string heard_frame_id_;
+  uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet
   cv::Size last_size_;
   std::string last_frame_id_;
   cv::Size info_size_;

@@ -227,6 +227,38 @@ TEST(TrackerFrontEnd, ImagesMissingFromTheStreamAreCounted) {
   EXPECT_EQ(front.counts().dropped, 0);
 }
 
+// A stream with bad phases (hostile new-user try: a driver sending 32FC1 now and then):
+// a bad image arrived, so it is dropped, not missing; images that never arrive among
+// them are still missing.
+TEST(TrackerFrontEnd, ImagesDroppedAsBadAreNotAlsoMissing) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  cv::Mat depth(grey.size(), CV_32FC1, cv::Scalar(1.5f));
+  long expected_missing = 0, expected_dropped = 0;
+  for (int k = 0; k < 91; ++k) {  // the last, 90, arrives (bad): 89 is counted missing
+    const uint32_t nsecs = static_cast<uint32_t>(k) * 10000000;
+    if (k >= 60 && k % 4 == 1) {  // the last phase: one image in four never arrives
+      ++expected_missing;
+      continue;
+    }
+    if (k >= 20 && k % 2 == 0) {  // from the 20th on every other image is bad
+      std_msgs::Header header;
+      header.stamp = ros::Time(100, nsecs);
+      header.frame_id = "camera";
+      const TrackerOutput out =
+          front.process(cv_bridge::CvImage(header, "32FC1", depth).toImageMsg());
+      EXPECT_FALSE(out.tracks);
+      ++expected_dropped;
+      continue;
+    }
+    const TrackerOutput out = front.process(image(grey, 100, nsecs));
+    ASSERT_TRUE(out.tracks);
+    for (const LogEvent& e : out.warnings) EXPECT_NE(e.kind, "gap") << e.text;
+  }
+  EXPECT_EQ(front.counts().dropped, expected_dropped);
+  EXPECT_EQ(front.counts().missing, expected_missing);
+}
+
 // A 1 Hz camera (or bag): its first pauses restart tracking, then one second between
 // images is its rhythm and the tracks go on (ids kept); four seconds is a pause again.
 TEST(TrackerFrontEnd, LowRateStreamKeepsTrackingOnceItsPeriodIsKnown) {
