@@ -43,6 +43,30 @@ Outcome run(const SyntheticTracks& world, int frames, bool odometry = false,
   return r;
 }
 
+// A camera_height map's frame is the floor's (its own origin and heading): its landmarks
+// are compared with the true points after the rigid motion (no scale) that best aligns
+// them. Errors sorted, m.
+struct LandmarkFit {
+  Pose world_from_map;
+  std::vector<double> errors;
+};
+
+LandmarkFit fitLandmarks(const SyntheticTracks& world, const PoseEstimator& estimator) {
+  std::vector<cv::Vec3d> est, truth;
+  for (size_t i = 0; i < world.points.size(); ++i)
+    if (const auto x = estimator.landmarkPosition(100 + i)) {
+      est.push_back(*x);
+      truth.push_back(world.points[i]);
+    }
+  LandmarkFit fit;
+  if (est.size() < 3) return fit;
+  fit.world_from_map = rigidAlign(est, truth);
+  for (size_t i = 0; i < est.size(); ++i)
+    fit.errors.push_back(cv::norm(fit.world_from_map.apply(est[i]) - truth[i]));
+  std::sort(fit.errors.begin(), fit.errors.end());
+  return fit;
+}
+
 }  // namespace
 
 TEST(PoseEstimator, FollowsTheWheeledRobotInMetres) {
@@ -351,33 +375,24 @@ TEST(PoseEstimator, CameraHeightGivesMetres) {
       true_cam.push_back(trajectoryPose(world.trajectory, t).t);
     }
     ASSERT_EQ(estimator.metricSource(), MetricSource::kCameraHeight) << estimator.waitingFor();
-    // The map's frame is the floor's (its own origin and heading): compare after the
-    // rigid motion (no scale) that best aligns the landmarks with the true points.
-    std::vector<cv::Vec3d> est, truth;
-    for (size_t i = 0; i < world.points.size(); ++i)
-      if (const auto x = estimator.landmarkPosition(100 + i)) {
-        est.push_back(*x);
-        truth.push_back(world.points[i]);
-      }
-    ASSERT_GT(est.size(), 300u);
-    const Pose world_from_map = rigidAlign(est, truth);
+    const LandmarkFit fit = fitLandmarks(world, estimator);
+    ASSERT_GT(fit.errors.size(), 300u);
+    const Pose& world_from_map = fit.world_from_map;
     const cv::Vec3d up = world_from_map.R * cv::Vec3d(0, 1, 0);  // the map's up, truth frame
     const double tilt_deg = std::acos(std::min(1.0, up[2])) * 180 / CV_PI;
-    std::vector<double> point_errors;
-    for (size_t i = 0; i < est.size(); ++i)
-      point_errors.push_back(cv::norm(world_from_map.apply(est[i]) - truth[i]));
-    std::sort(point_errors.begin(), point_errors.end());
+    const std::vector<double>& point_errors = fit.errors;
     double worst_cam = 0, path_m = 0;
     for (size_t i = 0; i < est_cam.size(); ++i) {
       worst_cam = std::max(worst_cam, cv::norm(world_from_map.apply(est_cam[i]) - true_cam[i]));
       if (i > 0) path_m += cv::norm(true_cam[i] - true_cam[i - 1]);
     }
     // The floor at y = 0 of the map: the camera's height is y.
-    std::printf("%s camera_height: posed %d, landmarks %zu median error %.3f m, camera worst "
-                "%.3f m over %.2f m, map tilt %.2f deg, height at start %.3f m, at end %.3f m "
-                "(true %.2f)\n",
-                path.c_str(), posed, est.size(), point_errors[point_errors.size() / 2], worst_cam,
-                path_m, tilt_deg, est_cam.front()[1], est_cam.back()[1], true_cam.back()[2]);
+    std::printf(
+        "%s camera_height: posed %d, landmarks %zu median error %.3f m, camera worst "
+        "%.3f m over %.2f m, map tilt %.2f deg, height at start %.3f m, at end %.3f m "
+        "(true %.2f)\n",
+        path.c_str(), posed, point_errors.size(), point_errors[point_errors.size() / 2], worst_cam,
+        path_m, tilt_deg, est_cam.front()[1], est_cam.back()[1], true_cam.back()[2]);
     // Measured (wheeled), with the local bundle adjustment (10 keyframes): camera worst
     // 0.9 % of the path (9.7 % without it: drift on these sparse tracks), landmarks'
     // median error 0.009 m (0.085), map tilt 0.21 deg (2.0; 4.1 before the floor check),
@@ -423,20 +438,10 @@ TEST(PoseEstimator, ImagesAreToldApartByTheirNumberNotTheirStamp) {
   }
   ASSERT_GE(first_posed, 0) << estimator.waitingFor();
   EXPECT_EQ(estimator.checkedFloor().image, first_posed);  // not checked again
-  // The landmarks where the points are (the map's frame is the floor's: align first).
-  std::vector<cv::Vec3d> est, truth;
-  for (size_t i = 0; i < world.points.size(); ++i)
-    if (const auto x = estimator.landmarkPosition(100 + i)) {
-      est.push_back(*x);
-      truth.push_back(world.points[i]);
-    }
-  ASSERT_GT(est.size(), 300u);
-  const Pose world_from_map = rigidAlign(est, truth);
-  std::vector<double> errors;
-  for (size_t i = 0; i < est.size(); ++i)
-    errors.push_back(cv::norm(world_from_map.apply(est[i]) - truth[i]));
-  std::sort(errors.begin(), errors.end());
-  EXPECT_LT(errors[errors.size() / 2], 0.05);  // as with distinct stamps (0.009 m)
+  // The landmarks where the points are.
+  const LandmarkFit fit = fitLandmarks(world, estimator);
+  ASSERT_GT(fit.errors.size(), 300u);
+  EXPECT_LT(fit.errors[fit.errors.size() / 2], 0.05);  // as with distinct stamps (0.009 m)
 }
 
 // The humanoid's synthetic tracks until its up-to-scale start has been checking the

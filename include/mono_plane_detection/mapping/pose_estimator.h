@@ -56,13 +56,13 @@ std::string metricSourceError(const std::string& choice);
 // camera pose (the anchor) is known.
 struct Landmark {
   bool triangulated = false;
-  bool fixed = false;             // a target corner: position known exactly
-  cv::Vec3d position;             // map frame, m (when triangulated or fixed)
-  Pose anchor_pose;               // map_from_camera at the anchor observation
+  bool fixed = false;              // a target corner: position known exactly
+  cv::Vec3d position;              // map frame, m (when triangulated or fixed)
+  Pose anchor_pose;                // map_from_camera at the anchor observation
   std::int64_t anchor_image = -1;  // that image's imageIndex() (a keyframe's, when it became one)
-  cv::Point2d anchor_normalized;  // undistorted normalised image coordinates there
-  double parallax_deg = 0;        // between the two rays of the triangulation
-  double last_seen = 0;           // stamp, s
+  cv::Point2d anchor_normalized;   // undistorted normalised image coordinates there
+  double parallax_deg = 0;         // between the two rays of the triangulation
+  double last_seen = 0;            // stamp, s
   // Anchored or triangulated from a vision-only pose while the odometry of an odometry
   // map was missing: used to place the camera, not given out (landmarkPosition), and
   // started again from the odometry when it returns.
@@ -188,8 +188,7 @@ class PoseEstimator {
   // camera_height: checks the start against the floor its landmarks show; true once the
   // map has been corrected (poses may be given out), false while waiting; undoes the
   // start when the floor disagrees.
-  bool checkFloor(PoseEstimate& estimate,
-                  const std::optional<Pose>& odom_from_camera);
+  bool checkFloor(PoseEstimate& estimate, const std::optional<Pose>& odom_from_camera);
   void undoFloorStart(const std::string& why);
   // Tracks of this image with a landmark position (landmarkPosition).
   int landmarksInView(const TrackFrame& frame) const;
@@ -252,7 +251,7 @@ class PoseEstimator {
     std::vector<std::uint64_t> ids;
     std::vector<cv::Point2d> normalized;
   };
-  std::int64_t image_index_ = -1;  // never reset: an index is not used twice
+  std::int64_t image_index_ = -1;   // never reset: an index is not used twice
   std::deque<Keyframe> keyframes_;  // the window (newest bundle_window) and as many before it
   std::vector<double> bundle_times_ms_;
   BundleCounts bundle_counts_;
