@@ -99,6 +99,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     publish_tf_ = node.publish_tf;
     transport_ = node.image_transport;
     max_odom_jump_m_ = node.max_odom_jump_m;
+    odom_wait_s_ = node.odom_wait_s;  // (not a live parameter)
     target_timeout_s_ = node.target_timeout_s;
     tf_mode_ = node.tf_mode;
     if (tf_mode_ != "auto" && tf_mode_ != "above_odom" && tf_mode_ != "below_odom") {
@@ -143,7 +144,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose, guard_,
                        node.expected_min_rate_hz, node.expected_max_rate_hz);
 
-    retry_timer_ = nh.createWallTimer(ros::WallDuration(kRetryS),
+    retry_timer_ = nh.createSteadyTimer(ros::WallDuration(kRetryS),
                                       guard_.wrap("odometry wait", [this](const auto&) { drain(); }),
                                       true /* oneshot */, false /* autostart */);
     // The map must follow every image, so tracks are always subscribed (the tracker
@@ -281,11 +282,14 @@ class PlaneNodelet : public nodelet::Nodelet {
         const std::filesystem::path path = std::filesystem::absolute(req.path, error);
         const std::filesystem::path target = error ? std::filesystem::path(req.path) : path;
         std::ofstream out(target);
+        const int open_errno = out ? 0 : errno;  // (meaningful right after the open only)
         out << planesYaml(*planes);
         out.close();
         if (!out) {
           res.message = "cannot write " + target.string() + " (" +
-                        std::error_code(errno, std::generic_category()).message() + ")";
+                        (open_errno ? std::error_code(open_errno, std::generic_category()).message()
+                                    : std::string("write failed")) +
+                        ")";
         } else {
           res.success = true;
           for (const auto& p : planes->planes) res.planes += p.metric;
@@ -338,8 +342,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   void onTfStatic(const tf2_msgs::TFMessageConstPtr& msg) {
     std::lock_guard<std::mutex> lock(static_mutex_);
     for (const auto& t : msg->transforms) {
-      auto strip = [](const std::string& f) { return f.rfind('/', 0) == 0 ? f.substr(1) : f; };
-      static_parents_[strip(t.child_frame_id)] = strip(t.header.frame_id);
+      static_parents_[tfFrame(t.child_frame_id)] = tfFrame(t.header.frame_id);
     }
   }
 
@@ -432,43 +435,48 @@ class PlaneNodelet : public nodelet::Nodelet {
   // their stamp: a robot's odometry often reaches tf a period after the image. tf2_ros's
   // MessageFilter waits too, but without a time bound: an image waits until its queue
   // overflows, so with odometry stopped every image is answered a queue length late and
-  // the last one before a pause never. All of this runs on the nodelet's single-threaded
-  // queue (getNodeHandle), tracks and retry timer alike; the mutexes only keep it safe.
+  // the last one before a pause never. Waits are measured on the steady clock (a clock
+  // step of the system time must not stretch or cut them short). This needs the
+  // nodelet's single-threaded queue (getNodeHandle), tracks and retry timer alike: on a
+  // multi-threaded one a callback would block on drain_mutex_ while another processes.
   void onTracks(const TracksConstPtr& msg) {
     diagnostics_.tick();
     {
       std::lock_guard<std::mutex> lock(pending_mutex_);
-      pending_.push_back({msg, ros::WallTime::now()});
+      pending_.push_back({msg, ros::SteadyTime::now()});
     }
     drain();
   }
 
   void drain() {
-    std::lock_guard<std::mutex> order(drain_mutex_);  // one image at a time, oldest first
+    bool look_again = false;
+    {
+      std::lock_guard<std::mutex> order(drain_mutex_);  // one image at a time, oldest first
+      look_again = drainLocked();
+    }
+    if (look_again) {  // (re-armed outside the lock) tf has no event per stamp
+      retry_timer_.stop();
+      retry_timer_.setPeriod(ros::WallDuration(kRetryS));
+      retry_timer_.start();
+    }
+  }
+
+  // Processes the waiting tracks in order; true when the oldest still waits.
+  bool drainLocked() {
     for (;;) {
       TracksConstPtr msg;
-      ros::WallTime arrived;
+      ros::SteadyTime arrived;
       size_t waiting = 0;
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
-        if (pending_.empty()) return;
+        if (pending_.empty()) return false;
         std::tie(msg, arrived) = pending_.front();
         waiting = pending_.size();
       }
-      const std::string frame = tfFrame(msg->header.frame_id);
-      if (!odom_frame_.empty() && node_.odom_wait_s > 0 && !frame.empty()) {
-        if (!odometry_live_ && odometryBack(frame, msg->header.stamp)) odometry_live_ = true;
-        if (odometry_live_ && waiting < kMaxPending &&
-            !tf_buffer_->canTransform(odom_frame_, frame, msg->header.stamp)) {
-          if ((ros::WallTime::now() - arrived).toSec() < node_.odom_wait_s) {
-            retry_timer_.stop();  // look again shortly (tf has no event per stamp)
-            retry_timer_.setPeriod(ros::WallDuration(kRetryS));
-            retry_timer_.start();
-            return;
-          }
-          odometry_live_ = false;  // waited in vain: the next tracks do not wait...
-          missed_stamp_ = msg->header.stamp;  // ...until tf's odometry passes this stamp
-        }
+      if (mustWait(*msg, waiting)) {
+        if ((ros::SteadyTime::now() - arrived).toSec() < odom_wait_s_) return true;
+        odometry_live_ = false;  // waited in vain: the next tracks do not wait...
+        missed_stamp_ = msg->header.stamp;  // ...until tf's odometry comes within reach
       }
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
@@ -478,18 +486,27 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
   }
 
-  // Odometry to wait for again: tf's newest odometry is past the stamp that waited in
-  // vain (it lags more than odom_wait_s now and then; a lookup at that stamp itself may
-  // never succeed once tf has forgotten it, after 10 s), or time went backwards (a new
-  // stream, a bag loop).
-  bool odometryBack(const std::string& frame, const ros::Time& stamp) const {
-    if (stamp < missed_stamp_) return true;
+  // Whether these tracks wait for their odometry: an odometry frame is set, tf links it
+  // to the tracks' camera at all (another camera's tracks, or none yet, do not wait),
+  // the odometry is live, fewer than kMaxPending wait, and tf lacks it at their stamp.
+  bool mustWait(const Tracks& msg, size_t waiting) {
+    const std::string frame = tfFrame(msg.header.frame_id);
+    if (odom_frame_.empty() || odom_wait_s_ <= 0 || frame.empty() || waiting >= kMaxPending)
+      return false;
+    ros::Time newest;
     try {
-      return tf_buffer_->lookupTransform(odom_frame_, frame, ros::Time(0)).header.stamp >
-             missed_stamp_;
+      newest = tf_buffer_->lookupTransform(odom_frame_, frame, ros::Time(0)).header.stamp;
     } catch (const tf2::TransformException&) {
       return false;
     }
+    // Wait again once the odometry is within reach: tf's newest is past the stamp that
+    // waited in vain and no further behind this image than odom_wait_s (odometry that
+    // always lags more is not waited for at every image), or time went backwards.
+    if (!odometry_live_)
+      odometry_live_ = msg.header.stamp < missed_stamp_ ||
+                       (newest > missed_stamp_ &&
+                        newest + ros::Duration(odom_wait_s_) >= msg.header.stamp);
+    return odometry_live_ && !tf_buffer_->canTransform(odom_frame_, frame, msg.header.stamp);
   }
 
   void process(const TracksConstPtr& msg) {
@@ -554,7 +571,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       metric_source_ = estimator ? toString(estimator->metricSource()) : "";
       // The tf of the odometry source stopped: vision carries the pose (landmarks in the
       // odometry's frame, so no jump), said in diagnostics.
-      odometry_stopped_ = !odom && !odom_frame_.empty() && metric_source_ == "odometry";
+      // Any source: without odometry no map <-> odom tf is published for the image.
+      odometry_stopped_ = !odom && !odom_frame_.empty();
       if (result.was_reset) {
         NODELET_WARN_THROTTLE(
             5.0,
@@ -654,8 +672,10 @@ class PlaneNodelet : public nodelet::Nodelet {
                                                  : "tracking lost: " + status_);
     else if (odometry_stopped_)
       status.summary(DiagnosticStatus::WARN,
-                     "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: "
-                     "camera pose from vision only");
+                     "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: " +
+                         (metric_source_ == "odometry"
+                              ? std::string("camera pose from vision only")
+                              : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
     else if (target_late)
       status.summary(DiagnosticStatus::WARN,
                      (node_.pipeline.pose.metric_source == "target"
@@ -703,9 +723,9 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_, static_sub_;
-  ros::WallTimer retry_timer_;  // drain() again while tracks wait for odometry
+  ros::SteadyTimer retry_timer_;  // drain() again while tracks wait for odometry
   std::mutex pending_mutex_, drain_mutex_;
-  std::deque<std::pair<TracksConstPtr, ros::WallTime>> pending_;  // arrival (wall) time
+  std::deque<std::pair<TracksConstPtr, ros::SteadyTime>> pending_;  // arrival (steady) time
   bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain...
   ros::Time missed_stamp_;      // ...for the odometry of the image of this stamp
   static constexpr double kRetryS = 0.005;
@@ -736,6 +756,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
+  double odom_wait_s_ = 0.25;
   double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
   std::optional<Pose> last_odom_;
   ros::Time last_odom_stamp_;
@@ -744,7 +765,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   size_t observed_ = 0;
   PlaneArrayConstPtr last_planes_;
   std::string metric_source_;     // the source that started the map, "" before
-  bool odometry_stopped_ = false;  // metric_source odometry but none for the last image
+  bool odometry_stopped_ = false;  // odom_frame set but no odometry for the last image
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)

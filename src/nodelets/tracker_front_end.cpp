@@ -120,44 +120,45 @@ void TrackerFrontEnd::reset() {
   target_wait_start_ns_ = target_wait_last_ns_ = 0;
   target_waited_before_s_ = 0;
   heard_ns_ = 0;
-  heard_frame_id_.clear();
   last_stamp_ns_ = 0;
   last_size_ = cv::Size();
   last_frame_id_.clear();
   gaps_.reset();
 }
 
-// Images missing from the stream are counted between messages heard, good or bad: an
-// image dropped here (a bad encoding, a wrong size) arrived and is counted as dropped;
-// counted as missing too, "missing" followed "dropped" through a stream's bad phases.
-// True when the interval since the last message heard is a pause.
-bool TrackerFrontEnd::hear(uint64_t stamp_ns, const std::string& frame_id) {
-  bool pause = false;
-  const bool other_camera =
-      !frame_id.empty() && !heard_frame_id_.empty() && frame_id != heard_frame_id_;
-  if (other_camera || stamp_ns < heard_ns_) {
-    gaps_.reset();  // another camera's or a new run's rhythm
-  } else if (heard_ns_ != 0 && stamp_ns > heard_ns_) {
+// Images missing from the stream are counted between the messages heard of the tracked
+// stream, the ones dropped here as bad (an encoding, a size) included: such an image
+// arrived and is counted as dropped; its stamp closes the interval, so it is not counted
+// as missing too (between tracked images only, a stream's bad phases counted each bad
+// image twice). A bad message of another camera, or stamped before the last one heard,
+// changes nothing here: the tracked images decide switches and time going back.
+void TrackerFrontEnd::hear(uint64_t stamp_ns) {
+  if (heard_ns_ != 0 && stamp_ns > heard_ns_) {
     const auto interval = static_cast<int64_t>(stamp_ns - heard_ns_);
-    pause = gaps_.isPause(interval, params_.max_gap_s);
-    if (pause)
+    if (gaps_.isPause(interval, params_.max_gap_s))
       gaps_.addPause(interval);
     else
       counts_.missing += gaps_.add(interval);
   }
-  heard_ns_ = stamp_ns;
-  if (!frame_id.empty()) heard_frame_id_ = frame_id;
-  return pause;
+  heard_ns_ = std::max(heard_ns_, stamp_ns);
+}
+
+// (A stamp a pause away from the stream's is not heard either: a bad message with a
+// broken clock would leave the rhythm waiting for its future stamp.)
+void TrackerFrontEnd::hearDropped(const std_msgs::Header& header) {
+  const bool same_camera = header.frame_id.empty() || last_frame_id_.empty() ||
+                           header.frame_id == last_frame_id_;
+  const uint64_t stamp_ns = header.stamp.toNSec();
+  if (last_stamp_ns_ == 0 || !same_camera || stamp_ns <= heard_ns_) return;
+  if (gaps_.isPause(static_cast<int64_t>(stamp_ns - heard_ns_), params_.max_gap_s)) return;
+  hear(stamp_ns);
 }
 
 TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   TrackerOutput out;
-  // Integer nanoseconds: (a - b) as a ros::Duration throws beyond 2^31 s (a driver with
-  // an uninitialised clock sends secs = 4000000000 after 1.7e9).
-  const uint64_t stamp_ns = msg->header.stamp.toNSec();
-  const bool heard_pause = hear(stamp_ns, msg->header.frame_id);
   out.grey = toGrey(msg);
   if (!out.grey.image) {
+    hearDropped(msg->header);
     ++counts_.dropped;
     out.dropped = out.grey.error;
     out.dropped_is_error = true;
@@ -165,11 +166,15 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   }
   const cv::Mat& image = out.grey.image->image;
   if (std::string error = imageSizeError(image.size(), params_.tracker); !error.empty()) {
+    hearDropped(msg->header);
     ++counts_.dropped;
     out.dropped = error;
     out.dropped_is_error = true;
     return out;
   }
+  // Integer nanoseconds: (a - b) as a ros::Duration throws beyond 2^31 s (a driver with
+  // an uninitialised clock sends secs = 4000000000 after 1.7e9).
+  const uint64_t stamp_ns = msg->header.stamp.toNSec();
   if (last_stamp_ns_ != 0 && stamp_ns == last_stamp_ns_) {
     ++counts_.dropped;  // the same image twice (a republisher, a bag with duplicates)
     out.dropped = "its stamp " + seconds(stamp_ns) + " repeats the previous one";
@@ -189,6 +194,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     tracker_.reset();
     target_startup_.reset();
     gaps_.reset();
+    heard_ns_ = stamp_ns;  // a new rhythm from here
     closeTargetWait();
   } else if (last_stamp_ns_ != 0 && stamp_ns < last_stamp_ns_) {
     out.warnings.push_back({"backwards", "image stamp " + seconds(stamp_ns) +
@@ -199,11 +205,14 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     tracker_.reset();
     target_startup_.reset();
     gaps_.reset();
+    heard_ns_ = stamp_ns;  // a new rhythm from here
     closeTargetWait();
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
-    // Longer than the interval heard when images were dropped since the last one tracked.
-    if (heard_pause || gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s)) {
+    // Judged before this interval joins the rhythm (a 1 Hz stream's first pauses).
+    const bool pause = gaps_.isPause(static_cast<int64_t>(gap_ns), params_.max_gap_s);
+    hear(stamp_ns);
+    if (pause) {
       // After a pause the scene may have moved anywhere: Lucas-Kanade would follow the
       // old points into the wrong places. The stream's rhythm stays (a low-rate camera
       // learns its period through its first pauses).
@@ -219,6 +228,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
                                         "nodelet will not name the camera"});
   last_size_ = image.size();
   last_stamp_ns_ = stamp_ns;
+  heard_ns_ = std::max(heard_ns_, stamp_ns);
   if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
   if (!info_size_.empty() && info_size_ != image.size()) {
     std::ostringstream why;

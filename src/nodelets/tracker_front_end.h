@@ -77,10 +77,10 @@ class TrackerFrontEnd {
   TrackerNodeParams params_;
   FeatureTracker tracker_;
   TargetStartup target_startup_;
-  // Every message heard, also one dropped as bad: the stream's rhythm (hear()).
-  bool hear(uint64_t stamp_ns, const std::string& frame_id);
-  uint64_t heard_ns_ = 0;  // 0: none yet
-  std::string heard_frame_id_;
+  // The stream's rhythm: every message heard of it, also one dropped as bad (hear()).
+  void hear(uint64_t stamp_ns);
+  void hearDropped(const std_msgs::Header& header);
+  uint64_t heard_ns_ = 0;       // newest stamp heard of the tracked stream; 0: none yet
   uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet
   cv::Size last_size_;
   std::string last_frame_id_;

@@ -123,7 +123,7 @@ class TrackerNodelet : public nodelet::Nodelet {
         error = std::string("cannot subscribe to ") + getNodeHandle().resolveName("image") +
                 " with image_transport '" + front_.params().image_transport + "' (" + why +
                 "): no tracks; install that transport or set image_transport: raw";
-        NODELET_ERROR("%s", error.c_str());
+        NODELET_ERROR_THROTTLE(10.0, "%s", error.c_str());  // (each listener retries)
       }
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       subscribe_error_ = error;

@@ -626,15 +626,17 @@ static void checkFrames(PlaneNodeParams& p, std::vector<std::string>& errors) {
                        frame->substr(1) + "'");
       frame->erase(0, 1);
     }
-  const PlaneNodeParams d;
   if (p.map_frame.empty() || p.map_frame == p.odom_frame || p.map_frame == p.camera_frame) {
+    // The default, unless that is the other frame's name too (odom_frame: plane_map).
+    std::string fallback = PlaneNodeParams().map_frame;
+    while (fallback == p.odom_frame || fallback == p.camera_frame) fallback += "_mono";
     errors.push_back("map_frame = '" + p.map_frame + "' " +
                      (p.map_frame.empty() ? std::string("is empty")
                                           : "is also the " + std::string(p.map_frame == p.odom_frame
                                                                              ? "odom_frame"
                                                                              : "camera_frame")) +
-                     "; using '" + d.map_frame + "'");
-    p.map_frame = d.map_frame;
+                     "; using '" + fallback + "'");
+    p.map_frame = fallback;
   }
 }
 

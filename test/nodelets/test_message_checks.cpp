@@ -259,6 +259,44 @@ TEST(TrackerFrontEnd, ImagesDroppedAsBadAreNotAlsoMissing) {
   EXPECT_EQ(front.counts().missing, expected_missing);
 }
 
+// Bad messages that are not of the tracked stream's rhythm (another camera's on the same
+// topic, a broken clock's: earlier or far later) neither restart tracking nor hide the
+// images missing from it.
+TEST(TrackerFrontEnd, BadMessagesOfAnotherCameraOrClockLeaveTheRhythm) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  const cv::Mat depth(grey.size(), CV_32FC1, cv::Scalar(1.5f));
+  auto bad = [&](const ros::Time& stamp, const std::string& frame) {
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = frame;
+    EXPECT_FALSE(front.process(cv_bridge::CvImage(header, "32FC1", depth).toImageMsg()).tracks);
+  };
+  long expected_missing = 0;
+  Tracks::_id_type ids_at_10;
+  for (int k = 0; k < 61; ++k) {
+    const uint32_t nsecs = static_cast<uint32_t>(k) * 10000000;
+    if (k > 10 && k % 7 == 0) {  // never arrives
+      ++expected_missing;
+      continue;
+    }
+    const TrackerOutput out = front.process(image(grey, 100, nsecs));
+    ASSERT_TRUE(out.tracks);
+    for (const LogEvent& e : out.warnings) EXPECT_NE(e.kind, "gap") << k << ": " << e.text;
+    if (k == 10) ids_at_10 = out.tracks->id;
+    bad(ros::Time(100, nsecs + 3000000), "depth");                // another camera
+    if (k % 5 == 0) bad(ros::Time(95, nsecs), "camera");          // 5 s early
+    if (k % 9 == 0) bad(ros::Time(4000000000u, 0), "camera");     // a clock far off
+  }
+  EXPECT_EQ(front.counts().missing, expected_missing);
+  // Still the same tracks: no restart (most of image 10's points are still there).
+  const TrackerOutput last = front.process(image(grey, 100, 610000000));
+  ASSERT_TRUE(last.tracks);
+  int kept = 0;
+  for (auto id : ids_at_10) kept += std::count(last.tracks->id.begin(), last.tracks->id.end(), id);
+  EXPECT_GT(kept, static_cast<int>(ids_at_10.size()) / 2);
+}
+
 // A 1 Hz camera (or bag): its first pauses restart tracking, then one second between
 // images is its rhythm and the tracks go on (ids kept); four seconds is a pause again.
 TEST(TrackerFrontEnd, LowRateStreamKeepsTrackingOnceItsPeriodIsKnown) {

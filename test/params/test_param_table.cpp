@@ -124,6 +124,12 @@ TEST(ParamTable, FrameNamesTfWouldRefuseAreRepaired) {
   EXPECT_NE(errors[1].find("is also the odom_frame"), std::string::npos) << errors[1];
   EXPECT_EQ(p.odom_frame, "odom");
   EXPECT_EQ(p.map_frame, "plane_map");
+  // The default would clash again: another name.
+  PlaneNodeParams clash;
+  clash.odom_frame = "plane_map";
+  errors = validate(clash);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(clash.map_frame, "plane_map_mono") << errors[0];
   PlaneNodeParams ok;
   ok.odom_frame = "odom";
   ok.camera_frame = "camera_estimate";

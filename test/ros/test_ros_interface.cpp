@@ -310,12 +310,12 @@ TEST(TfTree, StaysATreeWithOdometry) {
   for (int k = 0; k < 150; ++k) {
     sendFrame(k);
     if (HasFatalFailure()) return;
-    if (last->status == "tracking (odometry)")
+    if (last->status.rfind("tracking (odometry)", 0) == 0)  // (a suffix may follow)
       ++with_odometry;
     else if (with_odometry > 0)
       ++without_after_start;
   }
-  EXPECT_EQ(last->status, "tracking (odometry)");
+  EXPECT_EQ(last->status.rfind("tracking (odometry)", 0), 0u) << last->status;
   EXPECT_GT(with_odometry, 60);
   EXPECT_LE(without_after_start, 2);  // a loaded machine may miss the wait now and then
   spinUntil([] { return false; }, 1.0);  // the last transforms arrive
