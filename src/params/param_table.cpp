@@ -447,10 +447,10 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable() {
                  "an odometry move larger than this between two tracks messages is refused "
                  "(the visual pose is used)"});
     t.push_back({"odom_wait_s", field(&P::odom_wait_s), 0, 1, "s",
-                 "with odom_frame: how long tracks wait (wall time) for odometry at their "
-                 "stamp, more than the odometry's period plus its lag (10 Hz odometry 50 ms "
-                 "late: 0.15 s); after one wait in vain the next tracks do not wait until "
-                 "tf's odometry passes that stamp (0: never wait)"});
+                 "with odom_frame: how long tracks wait (steady clock) for odometry at "
+                 "their stamp, more than the odometry's period plus its lag (10 Hz odometry "
+                 "50 ms late: 0.15 s); after one wait in vain the next tracks do not wait "
+                 "until tf's odometry is within this of an image again (0: never wait)"});
     t.push_back({"expected_min_rate_hz", field(&P::expected_min_rate_hz), 0, 1e6, "Hz",
                  "diagnostics: a tracks rate below this is a warning"});
     t.push_back({"expected_max_rate_hz", field(&P::expected_max_rate_hz), 0, 1e6, "Hz",
