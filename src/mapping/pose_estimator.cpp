@@ -554,7 +554,8 @@ void PoseEstimator::placeStartLandmarks(
   // they hold its scale).
   keyframes_.clear();
   if (params_.bundle_window > 0) {
-    keyframes_.push_back(Keyframe{-1, map_from_first, ids, first});
+    // (The first view's number is not kept: -2, which no landmark's anchor_image is.)
+    keyframes_.push_back(Keyframe{-2, map_from_first, ids, first});
     keyframes_.push_back(Keyframe{image_index_, map_from_second, frame.ids, normalized});
   }
 }

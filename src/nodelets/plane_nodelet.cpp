@@ -145,7 +145,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                        node.expected_min_rate_hz, node.expected_max_rate_hz);
 
     retry_timer_ = nh.createSteadyTimer(ros::WallDuration(kRetryS),
-                                      guard_.wrap("odometry wait", [this](const auto&) { drain(); }),
+                                      guard_.wrap("odometry wait",
+                                                  [this](const auto&) { drain(); }),
                                       true /* oneshot */, false /* autostart */);
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens).
@@ -309,7 +310,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     try {
       // Never wait in a callback: drain() waited (odom_wait_s) without blocking; now
       // take what tf has for this stamp or go visual.
-      const auto tf = tf_buffer_->lookupTransform(odom_frame_, tfFrame(header.frame_id), header.stamp);
+      const auto tf =
+          tf_buffer_->lookupTransform(odom_frame_, tfFrame(header.frame_id), header.stamp);
       const Pose odom = fromTransformMsg(tf.transform);
       // tf2 rejects NaN but not infinity; a driver glitch can also jump far in one step.
       std::lock_guard<std::mutex> lock(mutex_);
@@ -675,7 +677,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                      "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: " +
                          (metric_source_ == "odometry"
                               ? std::string("camera pose from vision only")
-                              : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
+                              : "no " + map_frame_ + " <-> " + odom_frame_ +
+                                    " tf for these images"));
     else if (target_late)
       status.summary(DiagnosticStatus::WARN,
                      (node_.pipeline.pose.metric_source == "target"

@@ -59,7 +59,7 @@ struct Landmark {
   bool fixed = false;              // a target corner: position known exactly
   cv::Vec3d position;              // map frame, m (when triangulated or fixed)
   Pose anchor_pose;                // map_from_camera at the anchor observation
-  std::int64_t anchor_image = -1;  // that image's imageIndex() (a keyframe's, when it became one)
+  std::int64_t anchor_image = -1;  // that image's imageIndex() (-1: none)
   cv::Point2d anchor_normalized;   // undistorted normalised image coordinates there
   double parallax_deg = 0;         // between the two rays of the triangulation
   double last_seen = 0;            // stamp, s
@@ -246,7 +246,7 @@ class PoseEstimator {
   Similarity correction_;
   CheckedFloor checked_floor_;
   struct Keyframe {
-    std::int64_t image = -1;  // imageIndex() (-1: the two-view start's first view)
+    std::int64_t image = -2;  // imageIndex() (-2: the two-view start's first view)
     Pose map_from_camera;
     std::vector<std::uint64_t> ids;
     std::vector<cv::Point2d> normalized;
