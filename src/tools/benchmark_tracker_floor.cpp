@@ -5,6 +5,7 @@
 //     [--size WxH] [--features N]   (one row, e.g. to profile it)
 //     [--spread N]   (the tracker's search_spread_images; default: the tracker's default)
 //     [--noise-seed N]   (another draw of the sensor noise: how much a figure moves by chance)
+//     [--phase N]   (the swing starts N images on: the search images meet other motion)
 //
 // Real frames: a real image (EuRoC, TUM office) moved by known homographies. The data
 // sets hold stills (EuRoC: the vehicle stands) or images 1 s apart (TUM), neither a
@@ -50,7 +51,7 @@ struct Sequence {
 };
 
 Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int count,
-                      int noise_seed) {
+                      int noise_seed, int phase_images) {
   // The texture covers the view with a margin for the swing.
   cv::Mat texture;
   cv::resize(texture_source, texture, {cvRound(1.6 * size.width), cvRound(1.6 * size.height)}, 0,
@@ -60,7 +61,7 @@ Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int c
   Sequence s;
   cv::RNG rng(noise_seed);
   for (int k = 0; k < count; ++k) {
-    const double phase = 2 * CV_PI * k / 100.0;
+    const double phase = 2 * CV_PI * (k + phase_images) / 100.0;
     const cv::Point2d swing(0.2 * size.width * std::sin(phase), 0.08 * size.height * std::sin(2 * phase));
     const cv::Matx33d H = similarity(0.03 * std::sin(phase), centre, base + swing);
     cv::Mat view = warpView(texture, H, size);
@@ -305,7 +306,7 @@ int main(int argc, char** argv) {
   int count = 150, repeats = 3;
   std::string plot_path = "benchmark_tracker_floor.png";
   std::string euroc, tum, only_size;
-  int only_features = 0, spread = 0, noise_seed = 7;
+  int only_features = 0, spread = 0, noise_seed = 7, phase_images = 0;
   cli::Parser cli("benchmark_tracker_floor", "[options]",
                   "  The tracker against goodFeaturesToTrack every 10 images +\n"
                   "  calcOpticalFlowPyrLK, on generated texture and on real images moved by\n"
@@ -321,7 +322,10 @@ int main(int argc, char** argv) {
                "the tracker's search_spread_images (0: the tracker's default)")
       .integer("noise-seed", &noise_seed, 0, 1000000,
                "seed of the sensor noise (the quality figures of one seed move by chance: "
-               "compare several)");
+               "compare several)")
+      .integer("phase", &phase_images, 0, 99,
+               "start the swing this many images on (the search images then meet other "
+               "motion: which returning points a search finds first depends on it)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
 
@@ -349,18 +353,18 @@ int main(int argc, char** argv) {
       "ours / the floor's; n/s = mean ms on images without / with a search, ours and floor's.\n\n",
       count, repeats, kSteadyFrom);
   std::printf(
-      "search_spread_images %d, noise seed %d\n"
+      "search_spread_images %d, noise seed %d, phase %d\n"
       "%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s "
       "%11s\n",
-      spread > 0 ? spread : TrackerParams().search_spread_images, noise_seed, "source", "image", "feat",
-      "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s", "floor mean/p95/max", "wall",
-      "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept", "ids100", "reid", "srch",
-      "pts o/f", "ours n/s", "floor n/s");
+      spread > 0 ? spread : TrackerParams().search_spread_images, noise_seed, phase_images,
+      "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
+      "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept",
+      "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
   std::vector<Row> rows;
   for (const auto& [name, texture] : sources) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
       if (!only_size.empty() && only_size != cv::format("%dx%d", size.width, size.height)) continue;
-      const Sequence seq = makeSequence(texture, size, count, noise_seed);
+      const Sequence seq = makeSequence(texture, size, count, noise_seed, phase_images);
       for (int features : {50, 150, 500}) {
         if (only_features > 0 && features != only_features) continue;
         Row row{name, size, features, medianRow(seq, features, spread, repeats)};
