@@ -3,6 +3,9 @@
 // and tracking quality against ground truth. Writes a plot. A measurement, never a test.
 //   rosrun mono_plane_detection benchmark_tracker_floor [--frames N] [--euroc F] [--tum F]
 //     [--size WxH] [--features N]   (one row, e.g. to profile it)
+//     [--spread N]   (the tracker's search_spread_images; default: the tracker's default)
+//     [--noise-seed N]   (another draw of the sensor noise: how much a figure moves by chance)
+//     [--phase N]   (the swing starts N images on: the search images meet other motion)
 //
 // Real frames: a real image (EuRoC, TUM office) moved by known homographies. The data
 // sets hold stills (EuRoC: the vehicle stands) or images 1 s apart (TUM), neither a
@@ -47,7 +50,8 @@ struct Sequence {
   std::vector<cv::Matx33d> truth;  // texture pixel -> view pixel
 };
 
-Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int count) {
+Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int count,
+                      int noise_seed, int phase_images) {
   // The texture covers the view with a margin for the swing.
   cv::Mat texture;
   cv::resize(texture_source, texture, {cvRound(1.6 * size.width), cvRound(1.6 * size.height)}, 0,
@@ -55,9 +59,9 @@ Sequence makeSequence(const cv::Mat& texture_source, const cv::Size& size, int c
   const cv::Point2d centre(size.width / 2.0, size.height / 2.0);
   const cv::Point2d base(-0.3 * size.width, -0.3 * size.height);
   Sequence s;
-  cv::RNG rng(7);
+  cv::RNG rng(noise_seed);
   for (int k = 0; k < count; ++k) {
-    const double phase = 2 * CV_PI * k / 100.0;
+    const double phase = 2 * CV_PI * (k + phase_images) / 100.0;
     const cv::Point2d swing(0.2 * size.width * std::sin(phase), 0.08 * size.height * std::sin(2 * phase));
     const cv::Matx33d H = similarity(0.03 * std::sin(phase), centre, base + swing);
     cv::Mat view = warpView(texture, H, size);
@@ -140,10 +144,11 @@ struct RowResult {
   double ratio = 0;  // ours / floor mean time
 };
 
-RowResult runRow(const Sequence& seq, int features) {
+RowResult runRow(const Sequence& seq, int features, int spread) {
   RowResult r;
   TrackerParams params;
   params.max_features = features;
+  if (spread > 0) params.search_spread_images = spread;
   FeatureTracker tracker(params);
   TrackScorer score;
   Record ours, floor;
@@ -209,9 +214,9 @@ RowResult runRow(const Sequence& seq, int features) {
 
 // The median of `repeats` runs of a row, figure by figure (the machine is shared: one
 // run can be slowed by others).
-RowResult medianRow(const Sequence& seq, int features, int repeats) {
+RowResult medianRow(const Sequence& seq, int features, int spread, int repeats) {
   std::vector<RowResult> runs;
-  for (int r = 0; r < repeats; ++r) runs.push_back(runRow(seq, features));
+  for (int r = 0; r < repeats; ++r) runs.push_back(runRow(seq, features, spread));
   auto median = [&](auto get) {
     std::vector<double> v;
     for (const auto& r : runs) v.push_back(get(r));
@@ -301,7 +306,7 @@ int main(int argc, char** argv) {
   int count = 150, repeats = 3;
   std::string plot_path = "benchmark_tracker_floor.png";
   std::string euroc, tum, only_size;
-  int only_features = 0;
+  int only_features = 0, spread = 0, noise_seed = 7, phase_images = 0;
   cli::Parser cli("benchmark_tracker_floor", "[options]",
                   "  The tracker against goodFeaturesToTrack every 10 images +\n"
                   "  calcOpticalFlowPyrLK, on generated texture and on real images moved by\n"
@@ -312,7 +317,15 @@ int main(int argc, char** argv) {
       .text("euroc", &euroc, "a EuRoC image (752x480 grey) as real texture", "FILE.png")
       .text("tum", &tum, "a TUM RGB-D image (640x480 colour) as real texture", "FILE.png")
       .text("size", &only_size, "only the rows of this image size (profiling)", "WxH")
-      .integer("features", &only_features, 0, 100000, "only the rows of this count (0: all)");
+      .integer("features", &only_features, 0, 100000, "only the rows of this count (0: all)")
+      .integer("spread", &spread, 0, 100,
+               "the tracker's search_spread_images (0: the tracker's default)")
+      .integer("noise-seed", &noise_seed, 0, 1000000,
+               "seed of the sensor noise (the quality figures of one seed move by chance: "
+               "compare several)")
+      .integer("phase", &phase_images, 0, 99,
+               "start the swing this many images on (the search images then meet other "
+               "motion: which returning points a search finds first depends on it)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
 
@@ -340,8 +353,10 @@ int main(int argc, char** argv) {
       "ours / the floor's; n/s = mean ms on images without / with a search, ours and floor's.\n\n",
       count, repeats, kSteadyFrom);
   std::printf(
+      "search_spread_images %d, noise seed %d, phase %d\n"
       "%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s "
       "%11s\n",
+      spread > 0 ? spread : TrackerParams().search_spread_images, noise_seed, phase_images,
       "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
       "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept",
       "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
@@ -349,10 +364,10 @@ int main(int argc, char** argv) {
   for (const auto& [name, texture] : sources) {
     for (const cv::Size size : {cv::Size(320, 240), cv::Size(640, 480)}) {
       if (!only_size.empty() && only_size != cv::format("%dx%d", size.width, size.height)) continue;
-      const Sequence seq = makeSequence(texture, size, count);
+      const Sequence seq = makeSequence(texture, size, count, noise_seed, phase_images);
       for (int features : {50, 150, 500}) {
         if (only_features > 0 && features != only_features) continue;
-        Row row{name, size, features, medianRow(seq, features, repeats)};
+        Row row{name, size, features, medianRow(seq, features, spread, repeats)};
         const RowResult& r = row.result;
         auto alloc = [](const Timing& t) {
           return cv::format("%3.0f/%3.0f %4.0f/%4.0f", t.allocations, t.search_allocations,
