@@ -14,6 +14,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <cerrno>
 #include <deque>
 #include <filesystem>
@@ -477,6 +478,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       if (mustWait(*msg, waiting)) {
         if ((ros::SteadyTime::now() - arrived).toSec() < odom_wait_s_) return true;
+        ++odom_waits_in_vain_;
         odometry_live_ = false;  // waited in vain: the next tracks do not wait...
         missed_stamp_ = msg->header.stamp;  // ...until tf's odometry comes within reach
       }
@@ -695,6 +697,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
     status.add("camera switches (total)", camera_switches_);
     status.add("odometry refused (total)", refused_odom_);
+    if (!odom_frame_.empty())
+      status.add("odometry waited for in vain (total)", odom_waits_in_vain_.load());
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
@@ -760,6 +764,7 @@ class PlaneNodelet : public nodelet::Nodelet {
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
+  std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
   double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
   std::optional<Pose> last_odom_;
   ros::Time last_odom_stamp_;

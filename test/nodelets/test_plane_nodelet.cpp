@@ -526,6 +526,60 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
   EXPECT_LT(worst_step, 0.05);  // 0.01 m per image
 }
 
+// Odometry that always lags more than odom_wait_s (0.4 s against 0.25 s): after one wait
+// in vain the tracks go on without waiting (before: the wait was armed again each time
+// tf's odometry passed the stamp that waited, and output stalled 0.25 s every 0.4 s).
+TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryImage) {
+  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom_late", 100);
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
+      "planes_odom_late", 200,
+      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_late: planes");
+  tf2_ros::TransformBroadcaster broadcaster;
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
+  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  auto odometry = [&](int k) {
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(world_->frame(k / 30.0).stamp + 5500);
+    tf.header.frame_id = "odom_late";
+    tf.child_frame_id = "camera_optical_late";
+    tf.transform = toTransformMsg(rosMapFromTarget() * world_->truthMapFromCamera(k / 30.0));
+    return tf;
+  };
+  for (int i = 0; i < 10; ++i) {  // the link exists before the first image (its odometry lags)
+    geometry_msgs::TransformStamped tf = odometry(0);
+    tf.header.stamp -= ros::Duration(1.0);
+    broadcaster.sendTransform(tf);
+    ros::WallDuration(0.1 * timeoutScale()).sleep();
+  }
+  const int lag = 12, images = 90;  // 0.4 s at 30 images/s; 3 s of images
+  for (int k = 0; k < images + lag; ++k) {
+    if (k < images) {
+      TrackFrame f = world_->frame(k / 30.0);
+      for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;  // no target
+      f.stamp += 5500;  // its own time line
+      TracksPtr msg = toTracks(f);
+      msg->header.frame_id = "camera_optical_late";
+      tracks.publish(msg);
+    }
+    if (k >= lag) broadcaster.sendTransform(odometry(k - lag));
+    ros::WallDuration(1.0 / 30).sleep();
+    ros::spinOnce();
+  }
+  spinUntil([&] { return answers.size() >= static_cast<size_t>(images); }, 10.0);
+  EXPECT_EQ(answers.size(), static_cast<size_t>(images));
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long in_vain = diagnostics.number("odometry waited for in vain (total)");
+  std::printf("odometry 0.4 s late: %zu of %d images answered, %ld waited in vain\n",
+              answers.size(), images, in_vain);
+  EXPECT_GE(in_vain, 1);  // the first wait: it cannot know the lag before
+  EXPECT_LE(in_vain, 2);  // (before: one every 0.65 s, 4-5 here)
+  EXPECT_NE(diagnostics.message().find("odometry (odom_late) stopped, or later than odom_wait_s"),
+            std::string::npos)
+      << diagnostics.message();
+}
+
 // Killing the plane nodelet while tracks keep coming, and loading it again: it answers
 // at once (image-space planes until it has intrinsics and the start) and becomes metric.
 TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
