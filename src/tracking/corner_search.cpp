@@ -441,6 +441,47 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   return corners;
 }
 
+void bandShares(const cv::Size& full, const cv::Mat& level_image, int level,
+                const std::vector<cv::Point2f>& live, int wanted, const TrackerParams& params,
+                CornerSearchBuffers& buffers, std::vector<int>& shares) {
+  std::fill(shares.begin(), shares.end(), 0);
+  if (shares.empty() || wanted <= 0 || level_image.empty() || full.empty()) return;
+  const float scale = static_cast<float>(1 << level);
+  const double min_distance = params.min_distance_px / scale;
+  cv::Mat mask;
+  if (!live.empty()) {
+    buffers.shares_mask.create(level_image.size(), CV_8UC1);
+    buffers.shares_mask.setTo(cv::Scalar(255));
+    const int radius = static_cast<int>(std::ceil(min_distance));
+    for (const auto& p : live)
+      cv::circle(buffers.shares_mask, p / scale, radius, cv::Scalar(0), cv::FILLED);
+    mask = buffers.shares_mask;
+  }
+  const double cell_px = spreadCellPx(full, params.spread_grid_columns);
+  const double noise_floor =
+      cell_px > 0 && params.corner_noise_margin > 0
+          ? params.corner_noise_margin * noiseCornerFloor(level_image, level, params.block_size,
+                                                          cell_px / scale, &buffers.shares_noise)
+          : 0.0;
+  std::vector<cv::Point2f>& corners = buffers.shares_corners;
+  const size_t pool = static_cast<size_t>(cell_px > 0 ? std::max(wanted, 4 * params.max_features)
+                                                      : wanted);
+  shiTomasiCandidates(level_image, mask, params.quality_level, noise_floor, cell_px / scale,
+                      min_distance, params.block_size, noise_floor > 0 ? 0 : pool,
+                      buffers.shares_shi_tomasi, corners, buffers.shares_relaxed);
+  for (auto& c : corners) c *= scale;
+  if (cell_px > 0) spreadOverCells(corners, live, full, cell_px, static_cast<size_t>(wanted));
+  if (corners.size() > static_cast<size_t>(wanted)) corners.resize(wanted);
+  const int n = static_cast<int>(shares.size());
+  for (const auto& c : corners) {
+    // The band b with b * rows / n <= y < (b + 1) * rows / n (the tracker's bands).
+    int b = std::min(n - 1, static_cast<int>(c.y * n / full.height));
+    while (b > 0 && c.y < static_cast<float>(b * full.height / n)) --b;
+    while (b < n - 1 && c.y >= static_cast<float>((b + 1) * full.height / n)) ++b;
+    ++shares[b];
+  }
+}
+
 double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int block_size) {
   CV_Assert(derivatives.type() == CV_16SC2);
   const int half = std::max(0, block_size / 2);

@@ -300,8 +300,6 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   if (params_.reanchor_on_search) reanchor(gray, in_band);
   int wanted = params_.mask_existing ? params_.max_features - static_cast<int>(current_.size())
                                      : params_.max_features;
-  // Each band takes its share of what is still missing; the last, all of it.
-  if (part > 0) wanted = (wanted + parts - part) / (parts - part + 1);
   // A coarse level that came up short (the image's corners are fine-grained, or more
   // are wanted than it holds) costs a second search at full resolution: search there
   // directly, and try the coarse level again every fourth search (band).
@@ -311,6 +309,23 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   static const std::vector<cv::Point2f> kNone;
   // The pyramid holds each level's image and derivatives in turn (2 entries per level).
   const size_t per_level = pyramid.size() / (levels_built_ + 1);
+  // Each band takes, of what is still missing, the part that a search of the whole image
+  // would put in its rows and the bands after it (bandShares on the first band's image,
+  // one level coarser than the search); the last band, all of it. Equal shares made the
+  // bands of dark rows take weak corners (docs/benchmarks.md, fifth and sixth rounds).
+  if (part == 1) {
+    band_shares_.assign(static_cast<size_t>(parts), 0);
+    const int shares_level = std::min(levels_built_, level + 1);
+    bandShares(gray.size(), pyramid[shares_level * per_level], shares_level,
+               params_.mask_existing ? live : kNone, wanted, params_, search_buffers_,
+               band_shares_);
+  }
+  if (part > 0 && part < parts) {
+    int rest = 0;
+    for (int b = part - 1; b < static_cast<int>(band_shares_.size()); ++b) rest += band_shares_[b];
+    wanted = rest > 0 ? (wanted * band_shares_[part - 1] + rest / 2) / rest
+                      : (wanted + parts - part) / (parts - part + 1);
+  }
   const std::vector<cv::Point2f>& corners =
       findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
                   wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr, band);

@@ -433,3 +433,26 @@ TEST(CornerSearch, AWeakPatchGetsCornersAndAFlatNoisyPatchNone) {
     EXPECT_TRUE(buffers.relaxed.contains({400, 240}));
   }
 }
+
+// bandShares gives each band of rows what a search of the whole image would put there:
+// strong squares in the lower third and faint ones in the upper third, the cells of the
+// lower rows as empty as those of the upper: the strong corners come first.
+TEST(CornerSearch, BandSharesFollowTheWholeImagesStrongestCorners) {
+  const cv::Size size(640, 480);
+  Squares s = squares(size);
+  // The upper third's squares faint (200 -> 46 over a background of 40).
+  cv::Mat upper = s.image(cv::Rect(0, 0, size.width, size.height / 3));
+  upper = (upper - 40) / 26 + 40;
+  std::vector<cv::Mat> pyramid;
+  cv::buildPyramid(s.image, pyramid, 2);
+  TrackerParams params;
+  params.max_features = 400;
+  std::vector<int> shares(3, 0);
+  CornerSearchBuffers buffers;
+  bandShares(size, pyramid[2], 2, {}, 30, params, buffers, shares);
+  EXPECT_EQ(shares[0] + shares[1] + shares[2], 30);
+  EXPECT_LT(shares[0], shares[2]);
+  // Nothing wanted: nothing shared.
+  bandShares(size, pyramid[2], 2, {}, 0, params, buffers, shares);
+  EXPECT_EQ(shares[0] + shares[1] + shares[2], 0);
+}

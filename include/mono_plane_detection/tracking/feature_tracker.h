@@ -47,7 +47,8 @@ struct TrackerParams {
   int redetect_every = 10;                    // frames between searches at the latest
   // Beyond the paper: a search runs over this many images, a band of rows on each, so
   // that the search image does not cost several images' tracking (1: all at once, the
-  // default: 3 flattens frame times but keeps fewer ids, docs/tracking.md).
+  // default: 3 flattens frame times, but its mean error is higher on a few rows,
+  // docs/benchmarks.md, sixth round).
   int search_spread_images = 1;
 
   // Matching new corners to existing points (paper II-D).
@@ -197,6 +198,7 @@ class FeatureTracker {
   bool coarse_came_short_ = false;  // the last coarse search needed full resolution too
   int searches_at_full_ = 0;        // searches since, at full resolution
   int next_search_part_ = 0;  // the band of a spread search the next image runs, 0: none
+  std::vector<int> band_shares_;  // of a spread search, per band (bandShares on its first image)
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
   std::vector<LostPoint> lost_;                             // re-identification pool
 };
