@@ -50,6 +50,18 @@ int keepApart(std::vector<cv::Point2f>& corners, const std::vector<cv::Point2f>&
 
 namespace {
 
+// No new corner within min_distance (on this level) of a live point: a mask of the level's
+// size drawn into `buffer` (kept across searches); empty when there is no live point.
+cv::Mat liveMask(const cv::Size& size, const std::vector<cv::Point2f>& live, float scale,
+                 double min_distance, cv::Mat& buffer) {
+  if (live.empty()) return cv::Mat();
+  buffer.create(size, CV_8UC1);
+  buffer.setTo(cv::Scalar(255));
+  const int radius = static_cast<int>(std::ceil(min_distance));
+  for (const auto& p : live) cv::circle(buffer, p / scale, radius, cv::Scalar(0), cv::FILLED);
+  return buffer;
+}
+
 // The grouped median of |r| for integer values held in `histogram` (bin v: |r| == v),
 // interpolated within its bin, so that a low noise level is not rounded to a grey level.
 double groupedMedian(const int* histogram, int bins, int total) {
@@ -314,14 +326,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                          whole;
   if (on_level.empty()) return corners;
   const double min_distance = params.min_distance_px / scale;
-  cv::Mat mask;
-  if (!live.empty()) {
-    buffers.mask.create(level_image.size(), CV_8UC1);
-    buffers.mask.setTo(cv::Scalar(255));
-    const int radius = static_cast<int>(std::ceil(min_distance));
-    for (const auto& p : live) cv::circle(buffers.mask, p / scale, radius, cv::Scalar(0), cv::FILLED);
-    mask = buffers.mask;
-  }
+  const cv::Mat mask = liveMask(level_image.size(), live, scale, min_distance, buffers.mask);
   // On a coarse level, three times as many as wanted: they are ranked again at full
   // resolution. A coarse level ranks corners by their coarse structure, which changes
   // more from image to image than the full-resolution score; ranked by the latter, the
@@ -448,15 +453,8 @@ void bandShares(const cv::Size& full, const cv::Mat& level_image, int level,
   if (shares.empty() || wanted <= 0 || level_image.empty() || full.empty()) return;
   const float scale = static_cast<float>(1 << level);
   const double min_distance = params.min_distance_px / scale;
-  cv::Mat mask;
-  if (!live.empty()) {
-    buffers.shares_mask.create(level_image.size(), CV_8UC1);
-    buffers.shares_mask.setTo(cv::Scalar(255));
-    const int radius = static_cast<int>(std::ceil(min_distance));
-    for (const auto& p : live)
-      cv::circle(buffers.shares_mask, p / scale, radius, cv::Scalar(0), cv::FILLED);
-    mask = buffers.shares_mask;
-  }
+  const cv::Mat mask =
+      liveMask(level_image.size(), live, scale, min_distance, buffers.shares_mask);
   const double cell_px = spreadCellPx(full, params.spread_grid_columns);
   const double noise_floor =
       cell_px > 0 && params.corner_noise_margin > 0
