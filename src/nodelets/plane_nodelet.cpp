@@ -490,12 +490,14 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
   }
 
-  // Whether these tracks wait for their odometry: an odometry frame is set, tf links it
-  // to the tracks' camera at all (another camera's tracks, or none yet, do not wait),
-  // the odometry is live, fewer than kMaxPending wait, and tf lacks it at their stamp.
+  // Whether these tracks wait for their odometry: an odometry frame is set, fewer than
+  // kMaxPending wait, tf lacks the odometry at their stamp (the usual case, odometry in
+  // time, costs this one lookup), tf links the odometry to their camera at all (another
+  // camera's tracks, or none yet, do not wait), and the odometry is live.
   bool mustWait(const Tracks& msg, size_t waiting) {
     const std::string frame = tfFrame(msg.header.frame_id);
-    if (odom_frame_.empty() || odom_wait_s_ <= 0 || frame.empty() || waiting >= kMaxPending)
+    if (odom_frame_.empty() || odom_wait_s_ <= 0 || frame.empty() || waiting >= kMaxPending ||
+        tf_buffer_->canTransform(odom_frame_, frame, msg.header.stamp))
       return false;
     ros::Time newest;
     try {
@@ -510,7 +512,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       odometry_live_ = msg.header.stamp < missed_stamp_ ||
                        (newest > missed_stamp_ &&
                         newest + ros::Duration(odom_wait_s_) >= msg.header.stamp);
-    return odometry_live_ && !tf_buffer_->canTransform(odom_frame_, frame, msg.header.stamp);
+    return odometry_live_;
   }
 
   void process(const TracksConstPtr& msg) {

@@ -126,6 +126,17 @@ void TrackerFrontEnd::reset() {
   gaps_.reset();
 }
 
+// Tracking and the target search start over at this image; `new_rhythm` (a camera
+// switch, time going back): the stream's rhythm too (a pause keeps it).
+void TrackerFrontEnd::startOver(uint64_t stamp_ns, bool new_rhythm) {
+  tracker_.reset();
+  target_startup_.reset();
+  closeTargetWait();
+  if (!new_rhythm) return;
+  gaps_.reset();
+  heard_ns_ = stamp_ns;
+}
+
 // Images missing from the stream are counted between the messages heard of the tracked
 // stream, the ones dropped here as bad (an encoding, a size) included: such an image
 // arrived and is counted as dropped; its stamp closes the interval, so it is not counted
@@ -191,22 +202,14 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
         << "x" << last_size_.height << " -> '" << msg->header.frame_id << "' " << image.cols << "x"
         << image.rows << "): tracking starts over; one camera per image topic";
     out.warnings.push_back({"camera switch", why.str()});
-    tracker_.reset();
-    target_startup_.reset();
-    gaps_.reset();
-    heard_ns_ = stamp_ns;  // a new rhythm from here
-    closeTargetWait();
+    startOver(stamp_ns, true);
   } else if (last_stamp_ns_ != 0 && stamp_ns < last_stamp_ns_) {
     out.warnings.push_back({"backwards", "image stamp " + seconds(stamp_ns) +
                                              " is before the previous one (" +
                                              seconds(last_stamp_ns_) +
                                              "): time went backwards (bag loop?), tracking "
                                              "starts over"});
-    tracker_.reset();
-    target_startup_.reset();
-    gaps_.reset();
-    heard_ns_ = stamp_ns;  // a new rhythm from here
-    closeTargetWait();
+    startOver(stamp_ns, true);
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
     // Judged before this interval joins the rhythm (a 1 Hz stream's first pauses).
@@ -218,9 +221,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
       // learns its period through its first pauses).
       out.warnings.push_back({"gap", seconds(gap_ns) + " s without images: tracking lost, "
                                                        "starting over"});
-      tracker_.reset();
-      target_startup_.reset();
-      closeTargetWait();
+      startOver(stamp_ns, false);
     }
   }
   if (msg->header.frame_id.empty())

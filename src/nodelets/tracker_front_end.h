@@ -79,6 +79,7 @@ class TrackerFrontEnd {
   TargetStartup target_startup_;
   // The stream's rhythm: every message heard of it, also one dropped as bad (hear()).
   void hear(uint64_t stamp_ns);
+  void startOver(uint64_t stamp_ns, bool new_rhythm);
   void hearDropped(const std_msgs::Header& header);
   uint64_t heard_ns_ = 0;       // newest stamp heard of the tracked stream; 0: none yet
   uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet

@@ -41,6 +41,18 @@ using namespace mono_plane_detection;
 
 namespace {
 
+// Both ends linked: an answer published before our subscriber is connected is lost (seen
+// once with both cores busy: the first image "not answered").
+::testing::AssertionResult linked(const ros::Publisher& tracks, const ros::Subscriber& answers) {
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && answers.getNumPublishers() > 0; },
+            10.0);
+  if (tracks.getNumSubscribers() == 0)
+    return ::testing::AssertionFailure() << tracks.getTopic() << ": nobody listens";
+  if (answers.getNumPublishers() == 0)
+    return ::testing::AssertionFailure() << answers.getTopic() << ": nobody publishes";
+  return ::testing::AssertionSuccess();
+}
+
 TracksPtr toTracks(const TrackFrame& f) {
   TracksPtr msg(new Tracks);
   msg->header.stamp = ros::Time(f.stamp);
@@ -406,11 +418,7 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  // Both ends connected: an answer published before our subscriber is linked is lost
-  // (seen once with both cores busy: the first image "not answered").
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
-  ASSERT_GT(tracks.getNumSubscribers(), 0u);
-  ASSERT_GT(sub.getNumPublishers(), 0u);
+  ASSERT_TRUE(linked(tracks, sub));
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 90; ++k) {
@@ -458,11 +466,7 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
       [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_source: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  // Both ends connected: an answer published before our subscriber is linked is lost
-  // (seen once with both cores busy: the first image "not answered").
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
-  ASSERT_GT(tracks.getNumSubscribers(), 0u);
-  ASSERT_GT(sub.getNumPublishers(), 0u);
+  ASSERT_TRUE(linked(tracks, sub));
   std::optional<cv::Vec3d> previous;
   double worst_step = 0;
   int missed_after_pause = 0;
@@ -537,8 +541,7 @@ TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryIma
       [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_late: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
-  ASSERT_GT(tracks.getNumSubscribers(), 0u);
+  ASSERT_TRUE(linked(tracks, sub));
   auto odometry = [&](int k) {
     geometry_msgs::TransformStamped tf;
     tf.header.stamp = ros::Time(world_->frame(k / 30.0).stamp + 5500);
@@ -656,11 +659,7 @@ TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
       [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  // Both ends connected: an answer published before our subscriber is linked is lost
-  // (seen once with both cores busy: the first image "not answered").
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 10.0);
-  ASSERT_GT(tracks.getNumSubscribers(), 0u);
-  ASSERT_GT(sub.getNumPublishers(), 0u);
+  ASSERT_TRUE(linked(tracks, sub));
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 96; ++k) {
