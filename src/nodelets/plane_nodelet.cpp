@@ -442,11 +442,21 @@ class PlaneNodelet : public nodelet::Nodelet {
   // step of the system time must not stretch or cut them short). This needs the
   // nodelet's single-threaded queue (getNodeHandle), tracks and retry timer alike: on a
   // multi-threaded one a callback would block on drain_mutex_ while another processes.
+  // Malformed tracks are dropped on arrival: they never wait, nor hold back those behind.
   void onTracks(const TracksConstPtr& msg) {
     diagnostics_.tick();
+    std::string error;
+    TrackFrame frame = toTrackFrame(*msg, error);
+    if (!error.empty()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++dropped_;
+      if (problems_.note("tracks " + reasonKind(error), "tracks dropped: " + error))
+        NODELET_ERROR("tracks dropped: %s", error.c_str());
+      return;
+    }
     {
       std::lock_guard<std::mutex> lock(pending_mutex_);
-      pending_.push_back({msg, ros::SteadyTime::now()});
+      pending_.push_back({msg, std::move(frame), ros::SteadyTime::now()});
     }
     drain();
   }
@@ -473,7 +483,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
         if (pending_.empty()) return false;
-        std::tie(msg, arrived) = pending_.front();
+        msg = pending_.front().msg;
+        arrived = pending_.front().arrived;
         waiting = pending_.size();
       }
       if (mustWait(*msg, waiting)) {
@@ -482,11 +493,14 @@ class PlaneNodelet : public nodelet::Nodelet {
         odometry_live_ = false;  // waited in vain: the next tracks do not wait...
         missed_stamp_ = msg->header.stamp;  // ...until tf's odometry comes within reach
       }
+      TrackFrame frame;
       {
         std::lock_guard<std::mutex> lock(pending_mutex_);
+        frame = std::move(pending_.front().frame);
         pending_.pop_front();
       }
-      guard_.run("tracks", [&] { process(msg); });  // one bad message never stalls the rest
+      // One bad message never stalls the rest.
+      guard_.run("tracks", [&] { process(*msg, std::move(frame)); });
     }
   }
 
@@ -515,18 +529,10 @@ class PlaneNodelet : public nodelet::Nodelet {
     return odometry_live_;
   }
 
-  void process(const TracksConstPtr& msg) {
+  // frame: msg's tracks, checked on arrival (toTrackFrame).
+  void process(const Tracks& msg, TrackFrame frame) {
     const ros::WallTime started = ros::WallTime::now();
-    std::string error;
-    TrackFrame frame = toTrackFrame(*msg, error);
-    if (!error.empty()) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++dropped_;
-      if (problems_.note("tracks " + reasonKind(error), "tracks dropped: " + error))
-        NODELET_ERROR("tracks dropped: %s", error.c_str());
-      return;
-    }
-    const std::optional<Pose> odom = odometry(msg->header);
+    const std::optional<Pose> odom = odometry(msg.header);
     PlaneArrayPtr planes, image_planes;
     geometry_msgs::PoseStampedPtr pose;
     visualization_msgs::MarkerArrayPtr markers;
@@ -536,25 +542,25 @@ class PlaneNodelet : public nodelet::Nodelet {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       // An empty frame_id names no camera: only a named change or a size change counts.
-      const bool other_frame = !msg->header.frame_id.empty() && !last_frame_id_.empty() &&
-                               msg->header.frame_id != last_frame_id_;
+      const bool other_frame = !msg.header.frame_id.empty() && !last_frame_id_.empty() &&
+                               msg.header.frame_id != last_frame_id_;
       if (!last_tracks_size_.empty() && (other_frame || frame.size != last_tracks_size_)) {
         ++camera_switches_;
         // A recent problem, not a state: the diagnostics are OK again a while after the
         // last switch (the total stays).
         const std::string why = "tracks changed camera ('" + last_frame_id_ + "' " +
-                                sizeText(last_tracks_size_) + " -> '" + msg->header.frame_id +
+                                sizeText(last_tracks_size_) + " -> '" + msg.header.frame_id +
                                 "' " + sizeText(frame.size) + ")";
         if (problems_.note("tracks camera switch", "tracks mix cameras: " + why))
           NODELET_WARN("%s: one camera per tracks topic, or the planes of neither are found",
                        why.c_str());
       }
-      if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
+      if (!msg.header.frame_id.empty()) last_frame_id_ = msg.header.frame_id;
       last_tracks_size_ = frame.size;
       // Corners of a target of another size than ours would fix a wrong scale (two
       // nodelets configured apart): refused, loudly, until they agree. Every message says
       // the tracker's target, so a tracker relaunched with the right one clears it at once.
-      target_mismatch_ = targetMismatch(*msg, node_.pipeline.target);
+      target_mismatch_ = targetMismatch(msg, node_.pipeline.target);
       if (!target_mismatch_.empty()) {
         NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
         frame.target_corner.assign(frame.target_corner.size(), false);
@@ -610,9 +616,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       status_ = result.status;
       state_ = result.state;
       observed_ = result.planes.size();
-      std_msgs::Header map_header = msg->header;
+      std_msgs::Header map_header = msg.header;
       map_header.frame_id = map_frame_;
-      image_planes = toImagePlanes(msg->header, result);
+      image_planes = toImagePlanes(msg.header, result);
       planes = toMapPlanes(map_header, result, pipeline_->map());
       planes->metric_source = image_planes->metric_source = metric_source_;
       if (planes->metric) {
@@ -632,12 +638,12 @@ class PlaneNodelet : public nodelet::Nodelet {
         }
         if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
           cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
-        tf = transformFor(ros_map_from_camera, odom, msg->header);
+        tf = transformFor(ros_map_from_camera, odom, msg.header);
       }
       last_planes_ = planes;
       if (debug_pub_.getNumSubscribers() > 0) {
         for (const auto& image : images_)
-          if (image->header.stamp == msg->header.stamp) {
+          if (image->header.stamp == msg.header.stamp) {
             try {
               drawing = drawPlanes(cv_bridge::toCvShare(image, "mono8")->image, result);
             } catch (const cv_bridge::Exception& e) {
@@ -655,7 +661,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (cloud) cloud_pub_.publish(cloud);
     if (tf) broadcaster_->sendTransform(*tf);
     if (!drawing.empty())
-      debug_pub_.publish(cv_bridge::CvImage(msg->header, "bgr8", drawing).toImageMsg());
+      debug_pub_.publish(cv_bridge::CvImage(msg.header, "bgr8", drawing).toImageMsg());
   }
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
@@ -734,7 +740,12 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::Subscriber tracks_sub_, info_sub_, static_sub_;
   ros::SteadyTimer retry_timer_;  // drain() again while tracks wait for odometry
   std::mutex pending_mutex_, drain_mutex_;
-  std::deque<std::pair<TracksConstPtr, ros::SteadyTime>> pending_;  // arrival (steady) time
+  struct PendingTracks {
+    TracksConstPtr msg;
+    TrackFrame frame;         // msg's tracks, checked
+    ros::SteadyTime arrived;  // (steady clock)
+  };
+  std::deque<PendingTracks> pending_;
   bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain...
   ros::Time missed_stamp_;      // ...for the odometry of the image of this stamp
   static constexpr double kRetryS = 0.005;

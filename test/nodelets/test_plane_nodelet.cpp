@@ -556,6 +556,20 @@ TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryIma
     broadcaster.sendTransform(tf);
     ros::WallDuration(0.1 * timeoutScale()).sleep();
   }
+  {  // A malformed message is dropped on arrival: it never waits for its odometry (it
+     // waited in vain before, and switched the wait off for the good ones).
+    TrackFrame f = world_->frame(0);
+    f.stamp += 5500 - 0.5;
+    TracksPtr msg = toTracks(f);
+    msg->header.frame_id = "camera_optical_late";
+    msg->u.pop_back();
+    tracks.publish(msg);
+    spinUntil([&] { return diagnostics.number("tracks messages dropped") >= 1; }, 5.0);
+    ros::WallDuration(0.5).sleep();  // twice odom_wait_s: a wait would have ended
+    ASSERT_TRUE(diagnostics.waitFresh());
+    EXPECT_EQ(diagnostics.number("tracks messages dropped"), 1);
+    EXPECT_EQ(diagnostics.number("odometry waited for in vain (total)"), 0);
+  }
   const int lag = 12, images = 90;  // 0.4 s at 30 images/s; 3 s of images
   for (int k = 0; k < images + lag; ++k) {
     if (k < images) {
