@@ -23,7 +23,7 @@ CATKIN := source /opt/ros/noetic/setup.bash 2>/dev/null || true; cd $(WS) && cat
 DEVEL := $(WS)/devel/setup.bash
 DATA ?= $(REPO)/../shared/data/adelaidermf_dev
 
-.PHONY: deps link build demo test bench eval eval-euroc sanitize sanitize-build helgrind fuzz clean
+.PHONY: deps link build demo test bench eval eval-euroc sanitize sanitize-build sanitize-run helgrind fuzz clean
 
 deps:
 	@scripts/install_deps.sh
@@ -127,6 +127,10 @@ SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sani
 sanitize: deps
 	@$(MAKE) --no-print-directory link
 	@$(MAKE) --no-print-directory sanitize-build
+	@$(MAKE) --no-print-directory sanitize-run
+
+# The sanitized tests alone (after sanitize-build).
+sanitize-run:
 	@SANITIZE_ALL=$(SANITIZE_ALL) scripts/run_sanitized.sh $(ASAN_WS)/devel/lib/mono_plane_detection $(JOBS)
 
 # The sanitizer workspace's build alone (after make build: deps and links in place).
