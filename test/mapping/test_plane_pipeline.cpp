@@ -285,12 +285,18 @@ PipelineParams cameraHeightParams() {
   return params;
 }
 
-TEST(PlanePipeline, TheFloorTheCheckFittedIsTheMapsFloor) {
+// The thin-floor room seen by a camera_height pipeline.
+class PlanePipelineThinFloor : public ::testing::Test {
+ protected:
+  void SetUp() override { pipeline.setCamera(world.camera.K(), world.camera.distortion()); }
+
   const unsigned seed = 3;
   SyntheticTracks world = thinFloorRoom(seed);
   const PipelineParams params = cameraHeightParams();
-  PlanePipeline pipeline(params);
-  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PlanePipeline pipeline{params};
+};
+
+TEST_F(PlanePipelineThinFloor, TheFloorTheCheckFittedIsTheMapsFloor) {
   const cv::Vec3d up(0, 1, 0);  // the truth's (the target's frame: y up)
   // The truth's orientation of the map from the cameras' (summed over the placed images):
   // well fixed by each, while the short straight path after the turn fixes the rotation
@@ -335,12 +341,7 @@ TEST(PlanePipeline, TheFloorTheCheckFittedIsTheMapsFloor) {
 // Two images with one stamp (a driver that stamps twice): images are told apart by their
 // number (PoseEstimator::imageIndex), so the start is checked and placed as with distinct
 // stamps and the floor the check fitted is one confirmed map plane.
-TEST(PlanePipeline, TwinStampsStillCheckAndMapTheFloor) {
-  const unsigned seed = 3;
-  SyntheticTracks world = thinFloorRoom(seed);
-  const PipelineParams params = cameraHeightParams();
-  PlanePipeline pipeline(params);
-  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+TEST_F(PlanePipelineThinFloor, TwinStampsStillCheckAndMapTheFloor) {
   int placed = 0;
   for (int k = 0; k < 300; ++k) {
     TrackFrame room = withoutTarget(world.frame(k / 30.0, 0.5, seed));
