@@ -28,6 +28,23 @@ std::string sizeAndProjectionError(const sensor_msgs::CameraInfo& info) {
   return {};
 }
 
+// image_geometry's model of the camera (binning and ROI applied to K and P), or the reason
+// it refused the message.
+std::string cameraModelOf(const sensor_msgs::CameraInfo& info,
+                          image_geometry::PinholeCameraModel& model) {
+  try {
+    model.fromCameraInfo(info);
+  } catch (const std::exception& e) {
+    return std::string("image_geometry refused it: ") + e.what();
+  }
+  const cv::Size size = model.reducedResolution();
+  if (size.width <= 0 || size.height <= 0)
+    return "binning " + std::to_string(info.binning_x) + "x" + std::to_string(info.binning_y) +
+           " and ROI " + std::to_string(info.roi.width) + "x" + std::to_string(info.roi.height) +
+           " leave no image";
+  return {};
+}
+
 }  // namespace
 
 std::string cameraInfoError(const sensor_msgs::CameraInfo& info) {
@@ -67,20 +84,13 @@ std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, 
   if (!info.D.empty() && info.distortion_model == sensor_msgs::distortion_models::EQUIDISTANT)
     return "distortion model 'equidistant' is not OpenCV's pinhole model (see "
            "intrinsicsFromCameraInfo: cv::fisheye)";
-  if (info.D.empty()) {
-    for (int i = 0; i < 9; ++i) K.val[i] = info.K[i];
-    D = cv::Mat();
-    return {};
-  }
-  try {
-    image_geometry::PinholeCameraModel model;
-    model.fromCameraInfo(info);
-    K = model.intrinsicMatrix();
-    D = model.distortionCoeffs().clone();
-    D = D.reshape(1, 1);
+  image_geometry::PinholeCameraModel model;
+  if (std::string error = cameraModelOf(info, model); !error.empty()) return error;
+  K = model.intrinsicMatrix();  // of the images sent: binning and ROI applied
+  D = cv::Mat();
+  if (!info.D.empty()) {  // (reshape throws on an empty matrix)
+    D = model.distortionCoeffs().clone().reshape(1, 1);
     D.convertTo(D, CV_64F);
-  } catch (const std::exception& e) {
-    return std::string("image_geometry refused it: ") + e.what();
   }
   return {};
 }
@@ -89,26 +99,25 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
                                      CameraIntrinsics& out) {
   out = CameraIntrinsics();
   out.rectified = rectified;
+  image_geometry::PinholeCameraModel model;
   if (rectified) {
     // image_geometry: rectified pixels are those of P's left 3x3, without distortion
     // (D belongs to the raw image the stream was rectified from).
     if (std::string error = sizeAndProjectionError(info); !error.empty()) return error;
-    try {
-      image_geometry::PinholeCameraModel model;
-      model.fromCameraInfo(info);
-      const cv::Matx34d& P = model.projectionMatrix();
-      out.K = cv::Matx33d(P(0, 0), P(0, 1), P(0, 2), P(1, 0), P(1, 1), P(1, 2), P(2, 0), P(2, 1),
-                          P(2, 2));
-    } catch (const std::exception& e) {
-      return std::string("image_geometry refused it: ") + e.what();
-    }
+    if (std::string error = cameraModelOf(info, model); !error.empty()) return error;
+    const cv::Matx34d& P = model.projectionMatrix();
+    out.K = cv::Matx33d(P(0, 0), P(0, 1), P(0, 2), P(1, 0), P(1, 1), P(1, 2), P(2, 0), P(2, 1),
+                        P(2, 2));
     if (std::string error = cameraIntrinsicsError(out.K, cv::Mat()); !error.empty())
       return "P (rectified stream): " + error;
+    out.size = model.reducedResolution();
     return {};
   }
   if (std::string error = cameraInfoError(info); !error.empty()) return error;
+  if (std::string error = cameraModelOf(info, model); !error.empty()) return error;
+  out.size = model.reducedResolution();
   if (!info.D.empty() && info.distortion_model == sensor_msgs::distortion_models::EQUIDISTANT) {
-    for (int i = 0; i < 9; ++i) out.K.val[i] = info.K[i];
+    out.K = model.intrinsicMatrix();
     out.fisheye_D = cv::Mat(1, 4, CV_64F);
     for (int i = 0; i < 4; ++i) out.fisheye_D.at<double>(0, i) = info.D[i];
     return {};

@@ -2,8 +2,9 @@
 // size, finite K and P, the distortion model (image_geometry's names) and the number of
 // its coefficients OpenCV takes; and what image_geometry::PinholeCameraModel says the
 // pixels of a stream mean: a raw image has K and D, a rectified one (image_proc's
-// image_rect) has P and no distortion; equidistant (fisheye) pixels are moved to the
-// pinhole image of the same K with cv::fisheye before the core sees them.
+// image_rect) has P and no distortion, both of the images binning and ROI leave (a
+// camera_info's width, height, K and P are the sensor's); equidistant (fisheye) pixels
+// are moved to the pinhole image of the same K with cv::fisheye before the core sees them.
 #pragma once
 
 #include <sensor_msgs/CameraInfo.h>
@@ -19,12 +20,14 @@ namespace mono_plane_detection {
 std::string cameraInfoError(const sensor_msgs::CameraInfo& info);
 
 // K and D (1 x N, CV_64F; empty D: no distortion) of a usable raw camera_info with
-// OpenCV's pinhole model (through image_geometry::PinholeCameraModel), or the reason it
-// is not usable (equidistant included: intrinsicsFromCameraInfo handles it).
+// OpenCV's pinhole model (through image_geometry::PinholeCameraModel: K of the images
+// sent, binning and ROI applied), or the reason it is not usable (equidistant included:
+// intrinsicsFromCameraInfo handles it).
 std::string fromCameraInfo(const sensor_msgs::CameraInfo& info, cv::Matx33d& K, cv::Mat& D);
 
 // The camera as the core sees it.
 struct CameraIntrinsics {
+  cv::Size size;      // of the images it describes: width x height less binning and ROI
   cv::Matx33d K;      // of the pixels given to the core
   cv::Mat D;          // OpenCV's model (plumb_bob, rational_polynomial); empty: none
   cv::Mat fisheye_D;  // equidistant (1 x 4): tracks go through undistortFisheye first

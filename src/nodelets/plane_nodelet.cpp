@@ -240,7 +240,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       return;
     }
     camera_ = camera;
-    info_size_ = cv::Size(static_cast<int>(msg->width), static_cast<int>(msg->height));
+    info_size_ = camera.size;  // (binning and ROI applied)
   }
 
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

@@ -59,14 +59,14 @@ TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
 }
 
 std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) {
-  const std::string error = cameraInfoError(info);
-  info_size_ = error.empty() ? cv::Size(static_cast<int>(info.width), static_cast<int>(info.height))
-                             : cv::Size();
+  std::string error = cameraInfoError(info);
   // The target is searched with the lens undone (straight sides) and its aspect judged
   // with the focal length of the pixels it is searched in: a raw image's K and D, a
   // rectified one's P (image_geometry's camera model).
   CameraIntrinsics lens;
-  const bool usable = error.empty() && intrinsicsFromCameraInfo(info, rectified_, lens).empty();
+  if (error.empty()) error = intrinsicsFromCameraInfo(info, rectified_, lens);
+  const bool usable = error.empty();
+  info_size_ = usable ? lens.size : cv::Size();  // (binning and ROI applied)
   const bool fisheye = usable && !lens.fisheye_D.empty();
   focal_px_ = usable ? lens.K(0, 0) : 0;
   principal_px_ = usable ? cv::Point2d(lens.K(0, 2), lens.K(1, 2)) : cv::Point2d(-1, -1);

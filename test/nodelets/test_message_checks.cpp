@@ -149,6 +149,65 @@ TEST(CameraInfoCheck, EquidistantThroughCvFisheye) {
   EXPECT_TRUE(frame.target_corner[0]);
 }
 
+// A camera_info's width, height, K and P are the sensor's; binning and ROI say which part
+// of it the images hold, at what scale (image_geometry): K, P and the image size follow.
+TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
+  sensor_msgs::CameraInfo info = cameraInfo({-0.3, 0.1, 0, 0, 0});
+  info.width = 1280;
+  info.height = 960;
+  info.K = {1000, 0, 640, 0, 1000, 480, 0, 0, 1};
+  info.P = {900, 0, 630, 0, 0, 900, 470, 0, 0, 0, 1, 0};
+  CameraIntrinsics camera;
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.size, cv::Size(1280, 960));
+  EXPECT_EQ(camera.K(0, 0), 1000);
+  info.binning_x = info.binning_y = 2;  // images of 640x480
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.size, cv::Size(640, 480));
+  EXPECT_EQ(camera.K(0, 0), 500);
+  EXPECT_EQ(camera.K(1, 1), 500);
+  EXPECT_EQ(camera.K(0, 2), 320);
+  EXPECT_EQ(camera.D.total(), 5u);  // (distortion is of normalised coordinates: unchanged)
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, true, camera), "");  // rectified: P, halved
+  EXPECT_EQ(camera.size, cv::Size(640, 480));
+  EXPECT_EQ(camera.K(0, 0), 450);
+  EXPECT_EQ(camera.K(0, 2), 315);
+  info.roi.x_offset = 100;  // and a 640x480 window of the sensor from (100, 50)
+  info.roi.y_offset = 50;
+  info.roi.width = 640;
+  info.roi.height = 480;
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.size, cv::Size(320, 240));
+  EXPECT_EQ(camera.K(0, 2), 270);  // (640 - 100) / 2
+  EXPECT_EQ(camera.K(1, 2), 215);  // (480 - 50) / 2
+  info.D.clear();  // no distortion: the same K (it was taken unbinned)
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.K(0, 2), 270);
+  EXPECT_TRUE(camera.D.empty());
+  info.distortion_model = "equidistant";  // the fisheye path too
+  info.D = {0.05, -0.01, 0.002, -0.0005};
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.K(0, 0), 500);
+  EXPECT_EQ(camera.K(1, 2), 215);
+  // The tracker judges a binned camera's images by their own size: no "info size" warning.
+  info = cameraInfo({});
+  info.width = 1280;
+  info.height = 960;
+  info.K = {1000, 0, 640, 0, 1000, 480, 0, 0, 1};
+  info.binning_x = info.binning_y = 2;
+  TrackerFrontEnd front{TrackerNodeParams()};
+  ASSERT_EQ(front.setCameraInfo(info), "");
+  auto sizeWarnings = [](const TrackerOutput& out) {
+    int n = 0;
+    for (const LogEvent& w : out.warnings) n += w.kind == "info size";
+    return n;
+  };
+  EXPECT_EQ(sizeWarnings(front.process(image(textured({640, 480}), 100))), 0);
+  info.binning_x = info.binning_y = 1;  // the sensor's full size: not these images
+  ASSERT_EQ(front.setCameraInfo(info), "");
+  EXPECT_EQ(sizeWarnings(front.process(image(textured({640, 480}), 100, 33000000))), 1);
+}
+
 // Issue 15, case 1: secs = 4000000000 after 100: ros::Duration threw out of the callback.
 TEST(TrackerFrontEnd, StampsBeyondTwoToThe31SecondsAreCompared) {
   TrackerFrontEnd front;
