@@ -236,6 +236,10 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
         to.points.push_back(rest.points[i]);
         if (with_sigma) to.sigma_m.push_back(rest.sigma_m[i]);
       }
+      if (kept.points.size() == obs.points.size()) {  // a plane from motion, whole
+        kept.measured_from = obs.measured_from;
+        kept.normal_sigma_deg = obs.normal_sigma_deg;
+      }
       const int id = fuse(kept, fit.normal, fit.distance, stamp);
       if (id >= 0 && kept.points.size() > largest) {
         largest = kept.points.size();
@@ -287,6 +291,8 @@ int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double
     plane = &planes_[match];
   }
   for (size_t i = 0; i < kept.ids.size(); ++i) plane->points[kept.ids[i]] = {kept.points[i], stamp};
+  if (kept.normal_sigma_deg >= 0)
+    plane->motion_sigma_deg = std::min(plane->motion_sigma_deg, kept.normal_sigma_deg);
   if (!refit(*plane, kept.viewpoint)) {
     if (match < 0) {
       planes_.pop_back();
@@ -297,12 +303,15 @@ int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double
   // Count the observation only from a new viewpoint: images from one spot repeat the
   // same evidence (and the same mixture, if it is one).
   const double range = std::max(0.3, std::abs(plane->normal.dot(kept.viewpoint) - plane->distance));
-  const bool new_view = std::all_of(plane->views.begin(), plane->views.end(), [&](const cv::Vec3d& v) {
-    return cv::norm(v - kept.viewpoint) >= params_.view_spacing * range;
-  });
-  if (new_view) {
+  std::vector<cv::Vec3d> seen_from = kept.measured_from;
+  seen_from.push_back(kept.viewpoint);
+  for (const cv::Vec3d& from : seen_from) {
+    const bool new_view = std::all_of(plane->views.begin(), plane->views.end(), [&](const cv::Vec3d& v) {
+      return cv::norm(v - from) >= params_.view_spacing * range;
+    });
+    if (!new_view) continue;
     plane->observations += 1;
-    plane->views.push_back(kept.viewpoint);
+    plane->views.push_back(from);
     if (plane->views.size() > 16) plane->views.erase(plane->views.begin() + 1);  // bounded
   }
   plane->last_seen = stamp;
@@ -372,7 +381,8 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
   plane.distance = fit.distance;
   plane.rms_m = fit.rms_m;
   plane.polygon = planePolygon(fit.normal, fit.distance, inliers);
-  plane.normal_sigma_deg = normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m);
+  plane.normal_sigma_deg =
+      std::min(plane.motion_sigma_deg, normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m));
   return true;
 }
 
@@ -393,6 +403,7 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
       MapPlane merged = a;
       for (const auto& [id, entry] : b.points) merged.points.emplace(id, entry);
       merged.observations += b.observations;
+      merged.motion_sigma_deg = std::min(a.motion_sigma_deg, b.motion_sigma_deg);
       merged.views.insert(merged.views.end(), b.views.begin(), b.views.end());
       if (merged.views.size() > 16) merged.views.resize(16);
       merged.first_seen = std::min(a.first_seen, b.first_seen);

@@ -1,5 +1,7 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 
+#include "mono_plane_detection/mapping/plane_from_motion.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -63,6 +65,7 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   pending_.clear();
   history_.clear();
   previous_planes_.clear();
+  motion_planes_.clear();
   return {};
 }
 
@@ -80,6 +83,7 @@ void PlanePipeline::reset() {
   history_.clear();
   stream_.reset();
   previous_planes_.clear();
+  motion_planes_.clear();
 }
 
 PipelineResult PlanePipeline::process(const TrackFrame& frame,
@@ -95,6 +99,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       stream_.addPause(since_ns);
       history_.clear();
       previous_planes_.clear();
+      motion_planes_.clear();
       if (pose_) pose_->forgetLastPose();
       result.tracking_loss = true;
     } else {
@@ -135,6 +140,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   }
   // A rotation keeps the planes of the last image with parallax and their ids.
   if (!result.pure_rotation) assignImageIds(result.planes);
+  ++image_count_;
 
   // camera_height: the planes seen while the start is checked wait (track ids, camera)
   // and reach the map, corrected, once the check has passed; an undone start drops them.
@@ -165,12 +171,17 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       const std::vector<PlaneObservation> known = observationsOf({floor}, *result.pose);
       map_.addKnownPlane(known.front(), frame.stamp);
     }
-    const std::vector<int> map_ids =
-        map_.update(observationsOf(result.planes, *result.pose), frame.stamp);
+    std::vector<PlaneObservation> observations = observationsOf(result.planes, *result.pose);
+    if (params_.motion_plane_images > 0 && !result.pure_rotation &&
+        result.pose->source == PoseSource::kOdometry)
+      addMotionPlanes(result.planes, result.pose->map_from_camera, frame, normalized,
+                      observations);
+    const std::vector<int> map_ids = map_.update(observations, frame.stamp);
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
 
-  history_.push_back({frame, pose, std::move(normalized)});
+  history_.push_back({frame, pose, std::move(normalized),
+                      result.pose && result.pose->source == PoseSource::kOdometry});
   const int keep = std::max({1, params_.frame_gap, params_.max_keyframe_age});
   while (history_.size() > static_cast<size_t>(keep)) history_.pop_front();
 
@@ -229,6 +240,96 @@ std::vector<PlaneObservation> PlanePipeline::observationsOf(const std::vector<Im
     observations.push_back(std::move(obs));
   }
   return observations;
+}
+
+void PlanePipeline::addMotionPlanes(const std::vector<ImagePlane>& planes,
+                                    const Pose& map_from_camera, const TrackFrame& frame,
+                                    const std::vector<cv::Point2d>& normalized,
+                                    std::vector<PlaneObservation>& observations) {
+  if (normalized.size() != frame.ids.size()) return;
+  std::unordered_map<std::uint64_t, size_t> now;
+  for (size_t i = 0; i < frame.ids.size(); ++i) now.emplace(frame.ids[i], i);
+  const Pose camera_from_map = map_from_camera.inverse();
+  const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
+  for (size_t k = 0; k < planes.size(); ++k) {
+    MotionPlaneState& state = motion_planes_[planes[k].id];
+    ++state.images;
+    state.last_image = image_count_;
+    for (auto id : planes[k].inlier_ids) ++state.member_images[id];
+    if (static_cast<int>(observations[k].points.size()) >= params_.map.min_points) continue;
+    // The tracks that stayed: members in at least half of the plane's images.
+    std::vector<MotionCorrespondence> tracks;
+    std::vector<std::uint64_t> ids;
+    std::vector<cv::Vec3d> from;
+    for (auto id : planes[k].inlier_ids) {
+      if (state.member_images[id] < std::max(2.0, 0.5 * state.images)) continue;
+      const auto at = now.find(id);
+      if (at == now.end()) continue;
+      // Its earliest placed image within reach: the widest baseline.
+      for (const PastFrame& past : history_) {
+        if (!past.odometry || !past.map_from_camera ||
+            past.normalized.size() != past.frame.ids.size())
+          continue;
+        const auto it = std::find(past.frame.ids.begin(), past.frame.ids.end(), id);
+        if (it == past.frame.ids.end()) continue;
+        const cv::Point2d& y = past.normalized[static_cast<size_t>(it - past.frame.ids.begin())];
+        const Pose now_from_then = camera_from_map * *past.map_from_camera;
+        const cv::Vec3d ray = now_from_then.R * cv::Vec3d(y.x, y.y, 1);
+        tracks.push_back({now_from_then.t, ray / cv::norm(ray), normalized[at->second]});
+        ids.push_back(id);
+        if (std::find(from.begin(), from.end(), past.map_from_camera->t) == from.end())
+          from.push_back(past.map_from_camera->t);
+        break;
+      }
+    }
+    const MotionPlane fit = planeFromMotion(tracks, focal);
+    if (!fit.ok || fit.normal_sigma_deg <= 0 || fit.distance_sigma <= 0) continue;
+    const cv::Vec3d normal = map_from_camera.R * fit.normal;
+    const double distance = fit.distance + normal.dot(map_from_camera.t);
+    const double weight = 1 / (fit.normal_sigma_deg * fit.normal_sigma_deg);
+    const double distance_weight = 1 / std::pow(fit.distance_sigma * fit.distance, 2);
+    state.normal_sum += weight * normal;
+    state.normal_weight += weight;
+    state.distance_sum += distance_weight * distance;
+    state.distance_weight += distance_weight;
+    ++state.fits;
+    if (state.fits < params_.motion_plane_images ||
+        1 / std::sqrt(state.normal_weight) > params_.map.max_normal_sigma_deg)
+      continue;
+    // The fused plane; its tracks on it as seen now (landmarks where they have one).
+    const cv::Vec3d n = state.normal_sum / cv::norm(state.normal_sum);
+    const double d = state.distance_sum / state.distance_weight;
+    const double distance_sigma = 1 / std::sqrt(state.distance_weight);
+    PlaneObservation obs;
+    obs.viewpoint = map_from_camera.t;
+    obs.measured_from = from;
+    obs.normal_sigma_deg = 1 / std::sqrt(state.normal_weight);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const auto landmark = std::find(observations[k].ids.begin(), observations[k].ids.end(), ids[i]);
+      if (landmark != observations[k].ids.end()) {
+        const size_t at = static_cast<size_t>(landmark - observations[k].ids.begin());
+        obs.ids.push_back(ids[i]);
+        obs.points.push_back(observations[k].points[at]);
+        obs.sigma_m.push_back(observations[k].sigma_m[at]);
+        continue;
+      }
+      const cv::Point2d& z = normalized[now.at(ids[i])];
+      const cv::Vec3d ray = map_from_camera.R * cv::Vec3d(z.x, z.y, 1);
+      const double along = n.dot(ray);
+      if (std::abs(along) < 1e-9) continue;
+      const double s = (d - n.dot(map_from_camera.t)) / along;
+      if (!(s > 0)) continue;
+      obs.ids.push_back(ids[i]);
+      obs.points.push_back(map_from_camera.t + s * ray);
+      // Along the ray: the plane's distance error over the ray's slant to it.
+      obs.sigma_m.push_back(distance_sigma * cv::norm(ray) / std::abs(along));
+    }
+    observations[k] = std::move(obs);
+  }
+  // Planes the vote has not returned for a while have lost their id.
+  for (auto it = motion_planes_.begin(); it != motion_planes_.end();)
+    it = image_count_ - it->second.last_image > params_.max_keyframe_age ? motion_planes_.erase(it)
+                                                                         : std::next(it);
 }
 
 std::vector<cv::Point2d> PlanePipeline::normalize(const std::vector<cv::Point2d>& pixels) const {

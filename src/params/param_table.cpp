@@ -379,6 +379,11 @@ const ParamTable<PipelineParams>& pipelineParamTable() {
          "share of this image's tracks a reference must still hold"},
         {"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
          "a longer pause between tracks messages (and over 3 of their periods) is a tracking loss"},
+        {"motion_plane_images", field(&P::motion_plane_images), 0, 1000, "images",
+         "an image plane with too few landmarks: a plane from its tracks' motion and the "
+         "known poses, mapped after this many fits once its normal is known to "
+         "map/max_normal_sigma_deg (0: off; only for odometry right at the centimetre "
+         "scale, docs/mapping.md)"},
     };
     appendNested(t, "planes/", &P::planes, planeParamTable());
     appendNested(t, "pose/", &P::pose, poseParamTable());

@@ -314,3 +314,33 @@ TEST(PlaneMap, AKnownPlaneIsTakenWholeAndTheImagesJoinIt) {
   EXPECT_TRUE(map.planes()[0].confirmed(map.params()));
   EXPECT_LT(normalAngleDeg(map.planes()[0].normal, kFloor), 1.0);
 }
+
+// A plane from the tracks' motion (PipelineParams::motion_plane_images): its points lie on
+// it by construction, so its fit's sigma says how well it is known, and the camera centres
+// the fit took its tracks from count as views. A patch of 10 points (0.3 m wide) alone
+// leaves the normal loose by the points' measure; with the fit's 0.8 deg and two earlier
+// camera centres it is confirmed from one image.
+TEST(PlaneMap, APlaneFromMotionCountsItsFitsViewsAndSigma) {
+  PlaneObservation patch = observe(kWall, 0.0, 100, 10, 1, 0.15);
+  for (cv::Vec3d& p : patch.points) p[2] = 0;  // exactly on the plane, as constructed
+  {
+    PlaneMap map;
+    map.update({patch}, 1000);
+    ASSERT_EQ(map.planes().size(), 1u);
+    EXPECT_EQ(map.planes()[0].observations, 1);
+    EXPECT_GT(map.planes()[0].normal_sigma_deg, 1.0);
+    EXPECT_FALSE(map.planes()[0].confirmed(map.params()));
+  }
+  PlaneMap map;
+  patch.measured_from = {patch.viewpoint + cv::Vec3d(0.2, 0, 0),
+                         patch.viewpoint + cv::Vec3d(0.4, 0, 0)};
+  patch.normal_sigma_deg = 0.8;
+  map.update({patch}, 1000);
+  ASSERT_EQ(map.planes().size(), 1u);
+  EXPECT_EQ(map.planes()[0].observations, 3);
+  EXPECT_NEAR(map.planes()[0].normal_sigma_deg, 0.8, 1e-9);
+  EXPECT_TRUE(map.planes()[0].confirmed(map.params()));
+  // Later points of its own (landmarks) do not loosen it.
+  map.update({observe(kWall, 0.0, 200, 10, 2, 0.15)}, 1000.1);
+  EXPECT_LE(map.planes()[0].normal_sigma_deg, 0.8);
+}

@@ -1,6 +1,7 @@
 // The plane stage end to end on synthetic tracks with known planes and poses.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 
 #include "mono_plane_detection/eval/map_evaluation.h"
@@ -361,4 +362,45 @@ TEST_F(PlanePipelineThinFloor, TwinStampsStillCheckAndMapTheFloor) {
     }
   }
   EXPECT_EQ(holding, 1);
+}
+
+// With known poses (odometry) an image plane gets a plane from its tracks' motion before
+// its points have landmarks (motion_plane_images): the room's planes are confirmed
+// earlier (measured: image 15 instead of 57, the front wall 1.70 deg / 0.002 m off under
+// 0.2 px of independent noise per image), and every plane confirmed is a true one.
+TEST(PlanePipeline, WithKnownPosesPlanesAreMappedBeforeTheirLandmarks) {
+  const SyntheticTracks world("wheeled");
+  auto firstConfirmed = [&](int motion_plane_images, MapEvaluation& at_end) {
+    PipelineParams params;
+    params.pose.metric_source = "odometry";
+    params.motion_plane_images = motion_plane_images;
+    PlanePipeline pipeline(params);
+    pipeline.setCamera(world.camera.K(), world.camera.distortion());
+    int first = -1;
+    const int frames = 60;
+    for (int k = 0; k < frames; ++k) {
+      const double t = k / 30.0;
+      pipeline.process(world.frame(t), world.truthMapFromCamera(t));
+      std::vector<MapPlane> confirmed;
+      for (const MapPlane& p : pipeline.map().planes())
+        if (p.confirmed(pipeline.map().params())) confirmed.push_back(p);
+      if (first < 0 && !confirmed.empty()) first = k;
+      at_end = evaluateMap(confirmed, requiredTruth(world, frames), 0.10, 20.0, 0.3);
+    }
+    return first;
+  };
+  MapEvaluation without, with;
+  const int first_without = firstConfirmed(0, without);
+  const int first_with = firstConfirmed(5, with);
+  std::printf("first confirmed plane: image %d without, %d with planes from motion\n",
+              first_without, first_with);
+  for (const PlaneMatch& m : with.matches)
+    std::printf("  plane %d -> %s: %.2f deg, %.3f m\n", m.map_id, m.truth_name.c_str(),
+                m.normal_error_deg, m.distance_error_m);
+  ASSERT_GE(first_with, 0);
+  EXPECT_TRUE(first_without < 0 || first_with < first_without);
+  for (const PlaneMatch& m : with.matches) EXPECT_GE(m.truth_id, 0) << "plane " << m.map_id;
+  EXPECT_TRUE(with.split.empty());
+  EXPECT_LT(with.worst_normal_error_deg, 2.0);
+  EXPECT_LT(with.worst_distance_error_m, 0.05);
 }

@@ -53,6 +53,12 @@ struct PlaneObservation {
   // landmark's parallax and the pose's reprojection error. Empty: unknown, every point
   // gets max_residual_m.
   std::vector<double> sigma_m;
+  // A plane from the tracks' motion (PipelineParams::motion_plane_images): the camera
+  // centres its fit took the tracks from, counted as views besides `viewpoint`, and its
+  // normal's sigma from that fit (deg; -1: none, the points' spread decides). Its points
+  // lie on the plane by construction and say nothing about how well it is known.
+  std::vector<cv::Vec3d> measured_from;
+  double normal_sigma_deg = -1;
 };
 
 struct MapPlane {
@@ -63,6 +69,7 @@ struct MapPlane {
   // How well its points fix the normal (deg): rms / sqrt(points) against their spread
   // across the plane's long axis.
   double normal_sigma_deg = 180;
+  double motion_sigma_deg = 180;   // the best fit from the tracks' motion that joined it
   std::vector<cv::Vec3d> polygon;  // convex hull of its points, map frame
   int observations = 0;               // from distinct viewpoints (MapParams::view_spacing)
   std::vector<cv::Vec3d> views;      // the viewpoints counted, map frame
