@@ -148,43 +148,6 @@ double noiseCornerFloor(const cv::Mat& image, int level, int block_size, double 
   return noiseResponsePerLevel2(level, block_size) * noise * noise;
 }
 
-void minEigenValues(const cv::Mat& image, int block_size, cv::Mat& eig, MinEigenBuffers& buffers) {
-  CV_Assert(image.type() == CV_8UC1 && block_size > 0);
-  eig.create(image.size(), CV_32FC1);
-  if (image.empty()) return;
-  // The buffers keep the largest size asked for; a smaller image (a coarse level, a band)
-  // uses their top-left corner, so that searches of alternating levels allocate nothing.
-  auto region = [&](cv::Mat& buffer) {
-    if (buffer.type() != CV_32FC1 || buffer.rows < image.rows || buffer.cols < image.cols)
-      buffer.create(std::max(buffer.rows, image.rows), std::max(buffer.cols, image.cols),
-                    CV_32FC1);
-    return buffer(cv::Rect(0, 0, image.cols, image.rows));
-  };
-  cv::Mat dx = region(buffers.dx), dy = region(buffers.dy);
-  cv::Mat xx = region(buffers.xx), xy = region(buffers.xy), yy = region(buffers.yy);
-  // cornerEigenValsVecs: Sobel 3 scaled by 1 / (2^2 x block x 255) for 8-bit images, the
-  // products' box sums over the block (the image's border, not the buffers' beyond it).
-  const double scale = 1.0 / (4.0 * block_size * 255.0);
-  cv::Sobel(image, dx, CV_32F, 1, 0, 3, scale, 0, cv::BORDER_DEFAULT);
-  cv::Sobel(image, dy, CV_32F, 0, 1, 3, scale, 0, cv::BORDER_DEFAULT);
-  cv::multiply(dx, dx, xx);
-  cv::multiply(dx, dy, xy);
-  cv::multiply(dy, dy, yy);
-  for (cv::Mat* m : {&xx, &xy, &yy})
-    cv::boxFilter(*m, *m, CV_32F, cv::Size(block_size, block_size), cv::Point(-1, -1), false,
-                  cv::BORDER_DEFAULT | cv::BORDER_ISOLATED);
-  // calcMinEigenVal: a = xx / 2, b = xy, c = yy / 2, (a + c) - sqrt((a - c)^2 + b^2).
-  xx.convertTo(xx, CV_32F, 0.5);  // (halving is exact)
-  yy.convertTo(yy, CV_32F, 0.5);
-  cv::subtract(xx, yy, dx);
-  cv::multiply(dx, dx, dx);
-  cv::multiply(xy, xy, xy);
-  cv::add(dx, xy, dx);
-  cv::sqrt(dx, dx);
-  cv::add(xx, yy, dy);
-  cv::subtract(dy, dx, eig);
-}
-
 void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
                          double noise_floor, double cell_px, double min_distance, int block_size,
                          size_t max_corners, ShiTomasiBuffers& buffers,
@@ -193,7 +156,7 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
   relaxed_cells.clear();
   if (image.empty()) return;
   cv::Mat& eig = buffers.eig;
-  minEigenValues(image, block_size, eig, buffers.min_eigen);
+  cv::cornerMinEigenVal(image, eig, block_size, 3);
   double strongest = 0;
   cv::minMaxLoc(eig, nullptr, &strongest, nullptr, nullptr, mask);
   const float global_bar = static_cast<float>(quality_level * strongest);

@@ -2,8 +2,6 @@
 // exactly: the corners of bright squares on a dark background.
 #include <gtest/gtest.h>
 
-#include <cstdio>
-
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -156,45 +154,6 @@ TEST(CornerSearch, ShiTomasiScoreMatchesOpenCVsMinEigenValue) {
   EXPECT_GT(shiTomasiScore(derivatives, truth.corners[0], 3), 1e4);
   EXPECT_LT(shiTomasiScore(derivatives, {50, 30}, 3), 1.0);   // flat
   EXPECT_LT(shiTomasiScore(derivatives, {50, 60}, 3), 1e-6 + shiTomasiScore(derivatives, truth.corners[0], 3) / 100);  // edge
-}
-
-// minEigenValues is cornerMinEigenVal from kept buffers: the same values (to float
-// rounding; equal where OpenCV's build does not fuse its last multiply-add), on whole
-// images, small ones, a region of a larger image (its border pixels come from around it,
-// as OpenCV's Sobel takes them) and buffers left larger by an earlier call.
-TEST(CornerSearch, MinEigenValuesAreOpenCVsCornerMinEigenVal) {
-  cv::Mat noise(480, 640, CV_8UC1);
-  cv::RNG rng(3);
-  rng.fill(noise, cv::RNG::UNIFORM, 0, 256);
-  cv::GaussianBlur(noise, noise, cv::Size(5, 5), 1.2);
-  const cv::Mat squares_image = squares({320, 240}).image;
-  MinEigenBuffers buffers;
-  int equal_images = 0, images = 0;
-  auto check = [&](const cv::Mat& image, int block, const std::string& what) {
-    cv::Mat ours, theirs;
-    minEigenValues(image, block, ours, buffers);
-    cv::cornerMinEigenVal(image, theirs, block, 3);
-    ASSERT_EQ(ours.size(), image.size()) << what;
-    ASSERT_EQ(ours.type(), CV_32FC1) << what;
-    double strongest = 0;
-    cv::minMaxLoc(cv::abs(theirs), nullptr, &strongest);
-    EXPECT_LE(cv::norm(ours, theirs, cv::NORM_INF), 1e-6 * strongest + 1e-12) << what;
-    ++images;
-    equal_images += cv::norm(ours, theirs, cv::NORM_INF) == 0;
-  };
-  check(noise, 3, "640x480 noise");
-  check(squares_image, 3, "320x240 squares (buffers larger than the image)");
-  check(noise(cv::Rect(100, 50, 37, 23)), 3, "a region of a larger image");
-  check(noise.rowRange(160, 320), 3, "a band of rows");
-  check(noise(cv::Rect(0, 0, 2, 2)), 3, "2x2");
-  for (int block : {2, 5, 7}) check(noise, block, "block " + std::to_string(block));
-  std::printf("minEigenValues: equal to cornerMinEigenVal bit for bit on %d of %d images\n",
-              equal_images, images);
-  // The buffers grew once, to the largest image: a later call allocates nothing.
-  const uchar* kept = buffers.dx.data;
-  check(squares_image, 3, "again");
-  EXPECT_EQ(buffers.dx.data, kept);
-  EXPECT_EQ(buffers.dx.size(), cv::Size(640, 480));
 }
 
 namespace {

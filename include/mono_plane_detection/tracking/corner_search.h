@@ -68,22 +68,8 @@ struct RelaxedCells {
   bool contains(const cv::Point2f& p) const;
 };
 
-// Work buffers of minEigenValues, kept across calls.
-struct MinEigenBuffers {
-  cv::Mat dx, dy, xx, xy, yy;  // CV_32FC1, at least the largest image asked for
-};
-
-// cv::cornerMinEigenVal(image, eig, block_size, 3) (CV_8UC1 in, CV_32FC1 out) by its own
-// steps, each an OpenCV call into `buffers`: Sobel, the products, boxFilter, the smaller
-// eigenvalue. OpenCV allocates 6 MB of work images per call at 640 x 480, which glibc
-// (default thresholds) gives back to the system and faults in again at the next: half of
-// the call's time. The values are OpenCV's to float rounding (equal on this machine's
-// build: no fused multiply-add in its last step).
-void minEigenValues(const cv::Mat& image, int block_size, cv::Mat& eig, MinEigenBuffers& buffers);
-
 // Work buffers of shiTomasiCandidates.
 struct ShiTomasiBuffers {
-  MinEigenBuffers min_eigen;
   cv::Mat eig, dilated;
   std::vector<float> bar;
   std::vector<int> column_cell;
