@@ -565,10 +565,14 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
         frame.target_corner.assign(frame.target_corner.size(), false);
       }
-      if (!info_size_.empty() && info_size_ != frame.size)
-        NODELET_WARN_THROTTLE(10.0, "camera_info is for %dx%d images but tracks are of %dx%d",
-                              info_size_.width, info_size_.height, frame.size.width,
-                              frame.size.height);
+      // (Its size with binning and ROI applied: the images it describes.) Tracks that mix
+      // cameras explain a size that differs: that is said instead.
+      if (!info_size_.empty() && info_size_ != frame.size &&
+          !problems_.happened("tracks camera switch", kRecentS)) {
+        const std::string why = "camera_info is for " + sizeText(info_size_) +
+                                " images but tracks are of " + sizeText(frame.size);
+        if (problems_.note("camera_info size", why, 10.0)) NODELET_WARN("%s", why.c_str());
+      }
       if (!pipeline_->hasCamera())
         NODELET_WARN_THROTTLE(10.0,
                               "tracks arrive but no usable camera_info on %s: image-space "

@@ -27,6 +27,13 @@ class RecentEvents {
     return true;
   }
 
+  // Whether an event of this kind was noted within window_s.
+  bool happened(const std::string& kind, double window_s) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto it = events_.find(kind);
+    return it != events_.end() && (ros::WallTime::now() - it->second.last).toSec() <= window_s;
+  }
+
   // The last text of any kind noted within window_s, "" when none.
   std::string recent(double window_s) const {
     std::lock_guard<std::mutex> lock(mutex_);

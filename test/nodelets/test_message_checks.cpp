@@ -11,6 +11,7 @@
 
 #include "../../src/nodelets/camera_info_check.h"
 #include "../../src/nodelets/plane_messages.h"
+#include "../../src/nodelets/recent_events.h"
 #include "../../src/nodelets/tracker_front_end.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
 #include "mono_plane_detection/tracking/target_detector.h"
@@ -206,6 +207,24 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
   info.binning_x = info.binning_y = 1;  // the sensor's full size: not these images
   ASSERT_EQ(front.setCameraInfo(info), "");
   EXPECT_EQ(sizeWarnings(front.process(image(textured({640, 480}), 100, 33000000))), 1);
+}
+
+// What went wrong lately: one log per kind and period, the newest text for diagnostics,
+// and whether a kind happened lately (the plane nodelet's camera_info size warning yields
+// to tracks that mix cameras, which explain it).
+TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
+  RecentEvents events;
+  EXPECT_EQ(events.recent(10), "");
+  EXPECT_FALSE(events.happened("switch", 10));
+  EXPECT_TRUE(events.note("switch", "tracks mix cameras", 5));
+  EXPECT_FALSE(events.note("switch", "tracks mix cameras again", 5));  // within its period
+  EXPECT_TRUE(events.note("size", "camera_info is for 1280x960 images", 5));  // another kind
+  EXPECT_EQ(events.recent(10), "camera_info is for 1280x960 images");  // the newest
+  EXPECT_TRUE(events.happened("switch", 10));
+  EXPECT_FALSE(events.happened("rejected", 10));
+  ros::WallDuration(0.05).sleep();
+  EXPECT_FALSE(events.happened("switch", 0.01));  // not within the last 10 ms
+  EXPECT_EQ(events.recent(0.01), "");
 }
 
 // Issue 15, case 1: secs = 4000000000 after 100: ros::Duration threw out of the callback.

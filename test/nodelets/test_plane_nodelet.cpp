@@ -660,6 +660,28 @@ TEST_F(PlaneNodeletTest, K_CameraInfoDistortionVariants) {
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.number("camera_info messages rejected"), rejected + 4);
   EXPECT_EQ(diagnostics.number("exceptions caught (total)"), 0);
+  // The sensor's camera_info (twice the size and focal length) for binned images: with
+  // binning 2 it describes them (image_geometry: no size warning); without, it is another
+  // camera's, which diagnostics say.
+  sensor_msgs::CameraInfo sensor = cameraInfo(world_->camera);
+  sensor.width *= 2;
+  sensor.height *= 2;
+  for (int i : {0, 2, 4, 5}) sensor.K[i] *= 2;
+  for (int i : {0, 2, 5, 6}) sensor.P[i] *= 2;
+  const std::string other_size = "camera_info is for " + std::to_string(sensor.width) + "x" +
+                                 std::to_string(sensor.height) + " images";
+  sensor.binning_x = sensor.binning_y = 2;
+  last = publishAndDrive(sensor);
+  ASSERT_TRUE(last) << "no answer with binning 2";
+  EXPECT_NE(last->status, "no camera intrinsics: image-space planes only");
+  ASSERT_TRUE(diagnostics.waitFresh());  // (no size warning before this one)
+  EXPECT_EQ(diagnostics.message().find(other_size), std::string::npos) << diagnostics.message();
+  sensor.binning_x = sensor.binning_y = 1;
+  last = publishAndDrive(sensor);
+  ASSERT_TRUE(last) << "no answer with the sensor's camera_info";
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.message().find(other_size), std::string::npos) << diagnostics.message();
+  EXPECT_EQ(diagnostics.number("camera_info messages rejected"), rejected + 4);
   info_pub_.publish(cameraInfo(world_->camera));  // latched: leave a good one
 }
 
