@@ -551,7 +551,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         const std::string why = "tracks changed camera ('" + last_frame_id_ + "' " +
                                 sizeText(last_tracks_size_) + " -> '" + msg.header.frame_id +
                                 "' " + sizeText(frame.size) + ")";
-        if (problems_.note("tracks camera switch", "tracks mix cameras: " + why))
+        if (problems_.note(kCameraSwitch, "tracks mix cameras: " + why))
           NODELET_WARN("%s: one camera per tracks topic, or the planes of neither are found",
                        why.c_str());
       }
@@ -568,7 +568,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       // (Its size with binning and ROI applied: the images it describes.) Tracks that mix
       // cameras explain a size that differs: that is said instead.
       if (!info_size_.empty() && info_size_ != frame.size &&
-          !problems_.happened("tracks camera switch", kRecentS)) {
+          !problems_.happened(kCameraSwitch, kRecentS)) {
         const std::string why = "camera_info is for " + sizeText(info_size_) +
                                 " images but tracks are of " + sizeText(frame.size);
         if (problems_.note("camera_info size", why, 10.0)) NODELET_WARN("%s", why.c_str());
@@ -767,6 +767,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   RecentEvents problems_;  // refused tracks, camera_info, odometry
   static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
+  static constexpr const char* kCameraSwitch = "tracks camera switch";  // (problems_ kind)
   NodeletDiagnostics diagnostics_;
 
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline

@@ -472,10 +472,10 @@ void bandShares(const cv::Size& full, const cv::Mat& level_image, int level,
   if (corners.size() > static_cast<size_t>(wanted)) corners.resize(wanted);
   const int n = static_cast<int>(shares.size());
   for (const auto& c : corners) {
-    // The band b with b * rows / n <= y < (b + 1) * rows / n (the tracker's bands).
+    // The band b with bandTop(b) <= y < bandTop(b + 1) (the tracker's bands).
     int b = std::min(n - 1, static_cast<int>(c.y * n / full.height));
-    while (b > 0 && c.y < static_cast<float>(b * full.height / n)) --b;
-    while (b < n - 1 && c.y >= static_cast<float>((b + 1) * full.height / n)) ++b;
+    while (b > 0 && c.y < static_cast<float>(bandTop(b, full.height, n))) --b;
+    while (b < n - 1 && c.y >= static_cast<float>(bandTop(b + 1, full.height, n))) ++b;
     ++shares[b];
   }
 }

@@ -286,7 +286,7 @@ void FeatureTracker::moveLostWithImage() {
 // part 0: the whole image; 1..search_spread_images: that band of rows, from the top.
 void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part) {
   const int parts = std::max(1, params_.search_spread_images);
-  const int top = (part - 1) * gray.rows / parts, bottom = part * gray.rows / parts;
+  const int top = bandTop(part - 1, gray.rows, parts), bottom = bandTop(part, gray.rows, parts);
   const cv::Rect band = part == 0 ? cv::Rect() : cv::Rect(0, top, gray.cols, bottom - top);
   auto in_band = [&](const cv::Point2f& p) {
     return band.empty() || (p.y >= band.y && p.y < band.y + band.height);

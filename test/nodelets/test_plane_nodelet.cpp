@@ -53,6 +53,23 @@ namespace {
   return ::testing::AssertionSuccess();
 }
 
+// One of the launch file's other plane nodelets (topics tracks_<name>, planes_<name>): its
+// tracks publisher and its answers by stamp (ns). Not copyable: the subscription holds it.
+struct OtherNodelet {
+  OtherNodelet(ros::NodeHandle& nh, const std::string& name, uint32_t tracks_queue,
+               uint32_t planes_queue)
+      : tracks(nh.advertise<Tracks>("tracks_" + name, tracks_queue)),
+        planes(nh.subscribe<PlaneArray>(
+            "planes_" + name, planes_queue,
+            [this](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; })) {}
+  OtherNodelet(const OtherNodelet&) = delete;
+  OtherNodelet& operator=(const OtherNodelet&) = delete;
+
+  std::map<uint64_t, PlaneArrayConstPtr> answers;
+  ros::Publisher tracks;
+  ros::Subscriber planes;
+};
+
 TracksPtr toTracks(const TrackFrame& f) {
   TracksPtr msg(new Tracks);
   msg->header.stamp = ros::Time(f.stamp);
@@ -410,15 +427,13 @@ TEST_F(PlaneNodeletTest, H_WithoutCameraInfoThePlanesStayInTheImage) {
 // from an odometry origin 1 m aside and turned). The nodelet must take the pose from it
 // once the start has fixed map -> odom, and publish map -> odom.
 TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
-  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
-  std::map<uint64_t, PlaneArrayConstPtr> answers;
-  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
-      "planes_odom", 50,
-      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  OtherNodelet other(nh_, "odom", 20, 50);
+  ros::Publisher& tracks = other.tracks;
+  std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
   tf2_ros::TransformBroadcaster broadcaster;
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  ASSERT_TRUE(linked(tracks, sub));
+  ASSERT_TRUE(linked(other.tracks, other.planes));
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 90; ++k) {
@@ -459,14 +474,12 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
 // image, PlaneArray.metric_source says so; a tf that stops leaves the pose to vision
 // (no jump) and the diagnostics WARN; the odometry takes over again when it returns.
 TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
-  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom_source", 20);
-  std::map<uint64_t, PlaneArrayConstPtr> answers;
-  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
-      "planes_odom_source", 50,
-      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  OtherNodelet other(nh_, "odom_source", 20, 50);
+  ros::Publisher& tracks = other.tracks;
+  std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_source: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  ASSERT_TRUE(linked(tracks, sub));
+  ASSERT_TRUE(linked(other.tracks, other.planes));
   std::optional<cv::Vec3d> previous;
   double worst_step = 0;
   int missed_after_pause = 0;
@@ -534,14 +547,12 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
 // in vain the tracks go on without waiting (before: the wait was armed again each time
 // tf's odometry passed the stamp that waited, and output stalled 0.25 s every 0.4 s).
 TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryImage) {
-  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom_late", 100);
-  std::map<uint64_t, PlaneArrayConstPtr> answers;
-  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
-      "planes_odom_late", 200,
-      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  OtherNodelet other(nh_, "odom_late", 100, 200);
+  ros::Publisher& tracks = other.tracks;
+  std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_late: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  ASSERT_TRUE(linked(tracks, sub));
+  ASSERT_TRUE(linked(other.tracks, other.planes));
   auto odometry = [&](int k) {
     geometry_msgs::TransformStamped tf;
     tf.header.stamp = ros::Time(world_->frame(k / 30.0).stamp + 5500);
@@ -688,14 +699,12 @@ TEST_F(PlaneNodeletTest, K_CameraInfoDistortionVariants) {
 // Issue 15, case 7: an infinite odometry translation passes tf2; the nodelet published
 // metric: true with a NaN camera pose. A 100 m jump was taken as "tracking (odometry)".
 TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
-  ros::Publisher tracks = nh_.advertise<Tracks>("tracks_odom", 20);
-  std::map<uint64_t, PlaneArrayConstPtr> answers;
-  ros::Subscriber sub = nh_.subscribe<PlaneArray>(
-      "planes_odom", 50,
-      [&](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; });
+  OtherNodelet other(nh_, "odom", 20, 50);
+  ros::Publisher& tracks = other.tracks;
+  std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
   DiagnosticsProbe diagnostics(nh_, "plane_detector_odom: planes");
   tf2_ros::TransformBroadcaster broadcaster;
-  ASSERT_TRUE(linked(tracks, sub));
+  ASSERT_TRUE(linked(other.tracks, other.planes));
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 96; ++k) {

@@ -107,9 +107,12 @@ struct CornerSearchBuffers {
   std::vector<uchar> shares_relaxed;
 };
 
+// The first row of band b of a spread search over n bands of `rows` rows (band b holds
+// the rows bandTop(b) <= y < bandTop(b + 1)): the tracker's and bandShares' cut.
+inline int bandTop(int b, int rows, int n) { return b * rows / n; }
+
 // How many of `wanted` new corners a search of the whole image would put in each of
-// `shares.size()` bands of rows of `full` (band b: rows b * rows / n up to (b + 1) * rows /
-// n), estimated on `level_image`, level `level` of full's pyramid (one coarser than the
+// `shares.size()` bands of rows of `full` (bandTop), estimated on `level_image`, level `level` of full's pyramid (one coarser than the
 // search's, so that it costs little): the candidates above the quality bar under the live
 // points' mask, spread over the cells as the search spreads them (spreadOverCells: the
 // emptiest cells first, the image's strongest corner first among equals). Sums to at most
