@@ -61,13 +61,15 @@ struct OtherNodelet {
       : tracks(nh.advertise<Tracks>("tracks_" + name, tracks_queue)),
         planes(nh.subscribe<PlaneArray>(
             "planes_" + name, planes_queue,
-            [this](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; })) {}
+            [this](const PlaneArrayConstPtr& m) { answers[m->header.stamp.toNSec()] = m; })),
+        diagnostics(nh, "plane_detector_" + name + ": planes") {}
   OtherNodelet(const OtherNodelet&) = delete;
   OtherNodelet& operator=(const OtherNodelet&) = delete;
 
   std::map<uint64_t, PlaneArrayConstPtr> answers;
   ros::Publisher tracks;
   ros::Subscriber planes;
+  DiagnosticsProbe diagnostics;  // its task's status
 };
 
 TracksPtr toTracks(const TrackFrame& f) {
@@ -477,7 +479,7 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
   OtherNodelet other(nh_, "odom_source", 20, 50);
   ros::Publisher& tracks = other.tracks;
   std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
-  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_source: planes");
+  DiagnosticsProbe& diagnostics = other.diagnostics;
   tf2_ros::TransformBroadcaster broadcaster;
   ASSERT_TRUE(linked(other.tracks, other.planes));
   std::optional<cv::Vec3d> previous;
@@ -550,7 +552,7 @@ TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryIma
   OtherNodelet other(nh_, "odom_late", 100, 200);
   ros::Publisher& tracks = other.tracks;
   std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
-  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom_late: planes");
+  DiagnosticsProbe& diagnostics = other.diagnostics;
   tf2_ros::TransformBroadcaster broadcaster;
   ASSERT_TRUE(linked(other.tracks, other.planes));
   auto odometry = [&](int k) {
@@ -702,7 +704,7 @@ TEST_F(PlaneNodeletTest, L_NonFiniteOrJumpingOdometryIsRefused) {
   OtherNodelet other(nh_, "odom", 20, 50);
   ros::Publisher& tracks = other.tracks;
   std::map<uint64_t, PlaneArrayConstPtr>& answers = other.answers;
-  DiagnosticsProbe diagnostics(nh_, "plane_detector_odom: planes");
+  DiagnosticsProbe& diagnostics = other.diagnostics;
   tf2_ros::TransformBroadcaster broadcaster;
   ASSERT_TRUE(linked(other.tracks, other.planes));
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
