@@ -120,8 +120,8 @@ eval-euroc: build
 # Same sources, a second workspace with sanitizers (-O1 -g1: the sanitizers' usual level,
 # line numbers in reports, quicker to compile than -O2 -g; the test programs' own files
 # -O0, half the compile time of instrumented -O1). It builds and runs the gtests
-# that need no ROS master, JOBS at a time (scripts/run_sanitized.sh); those CMakeLists.txt
-# hosts in a rostest (add_rostest_gtest) stay in `make test`. Any report fails the run.
+# that need no ROS master but the command-line ones (CMakeLists.txt's sanitized_tests),
+# JOBS at a time (scripts/run_sanitized.sh). Any report fails the run.
 ASAN_WS := $(REPO)/build/ws_asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 sanitize: deps
@@ -139,7 +139,7 @@ sanitize-build:
 	@[ -e $(ASAN_WS)/src/mono_plane_detection ] || ln -sfn $(PKG) $(ASAN_WS)/src/mono_plane_detection
 	@cd $(ASAN_WS) && catkin_make -j$(JOBS) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DMPD_TEST_COMPILE_OPTIONS=-O0 mono_plane_detection_unit_tests > $(ASAN_WS)/build.log 2>&1 \
+	  -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DMPD_TEST_COMPILE_OPTIONS=-O0 mono_plane_detection_sanitized_tests > $(ASAN_WS)/build.log 2>&1 \
 	  || { tail -30 $(ASAN_WS)/build.log; exit 1; }
 
 clean:
