@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -196,6 +197,30 @@ TEST(ParamTable, ConfigFilesUseKnownNamesInRange) {
   }
   closedir(d);
   EXPECT_EQ(files, 7);
+}
+
+// A parameter a launch file sets only when its argument is given (<param if=...>) must have
+// its value in the config the same node loads on every launch: otherwise an earlier
+// launch's value stays on the parameter server (metric_source:=odometry once, and the
+// next plain launch waited for odometry).
+TEST(ParamTable, ParamsLaunchFilesSetConditionallyAreInTheConfig) {
+  const std::string dir = std::string(SOURCE_DIR);
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  flattenYaml(YAML::LoadFile(dir + "/config/planes.yaml"), "", keys);
+  std::set<std::string> in_config;
+  for (const auto& key : keys) in_config.insert(key.first);
+  std::ifstream launch(dir + "/launch/planes.launch");
+  ASSERT_TRUE(launch.good());
+  const std::string text((std::istreambuf_iterator<char>(launch)), std::istreambuf_iterator<char>());
+  int conditional = 0;
+  for (size_t at = text.find("<param if="); at != std::string::npos;
+       at = text.find("<param if=", at + 1)) {
+    const size_t name = text.find("name=\"", at) + 6;
+    const std::string param = text.substr(name, text.find('"', name) - name);
+    ++conditional;
+    EXPECT_TRUE(in_config.count(param)) << param << " is set only with its launch argument";
+  }
+  EXPECT_GE(conditional, 2);  // pose/metric_source, pose/camera_height_m
 }
 
 // Issue 12: target_type and the marker's dictionary are names the ranges cannot check:
