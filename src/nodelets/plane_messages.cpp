@@ -222,10 +222,21 @@ visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, con
     cv::Vec3d centre(0, 0, 0);
     for (const auto& v : polygon) centre += v;
     centre /= static_cast<double>(polygon.size());
-    for (size_t k = 0; k < polygon.size(); ++k) {  // a fan from the centre
-      surface.points.push_back(point(centre));
-      surface.points.push_back(point(polygon[k]));
-      surface.points.push_back(point(polygon[(k + 1) % polygon.size()]));
+    // A fan from the centre, each triangle twice: rviz lights a triangle by its winding's
+    // normal (the light comes from the viewer), so a plane seen from behind, as walls are
+    // from rviz's orbit view above the room, is drawn nearly black. The copy wound towards
+    // the side the plane was seen from comes second, on top: from there (and the floor from
+    // above) in full colour, from behind in about half of it.
+    for (size_t k = 0; k < polygon.size(); ++k) {
+      const cv::Vec3d& a = polygon[k];
+      const cv::Vec3d& b = polygon[(k + 1) % polygon.size()];
+      const bool facing = (a - centre).cross(b - centre).dot(normal) >= 0;
+      for (const auto& [first, second] : {std::make_pair(facing ? b : a, facing ? a : b),
+                                          std::make_pair(facing ? a : b, facing ? b : a)}) {
+        surface.points.push_back(point(centre));
+        surface.points.push_back(point(first));
+        surface.points.push_back(point(second));
+      }
     }
     markers->markers.push_back(surface);
 

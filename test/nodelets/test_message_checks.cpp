@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <opencv2/calib3d.hpp>
 
 #include "../../src/nodelets/camera_info_check.h"
@@ -587,4 +588,58 @@ TEST(PlaneMessages, ConfirmedPlanesAreFlagged) {
   for (const auto& m : markers->markers)
     if (m.ns == "labels") tentative_labels += m.text.find("tentative") != std::string::npos;
   EXPECT_EQ(tentative_labels, 1);
+}
+
+// rviz lights a triangle by the normal of its winding (the light comes from the viewer): a
+// wall seen from behind was drawn nearly black. Every surface triangle comes twice, first
+// wound away from the side its plane was seen from (the marker's normal arrow), then
+// towards it, for walls seen from either side and the floor.
+TEST(PlaneMessages, SurfacesFaceTheSideTheyWereSeenFrom) {
+  PlaneMap map;
+  auto wall = [](double z, double viewer_z, std::uint64_t first_id, unsigned k) {
+    PlaneObservation obs;
+    obs.viewpoint = {0.3 * k, 0, viewer_z};
+    for (int i = 0; i < 30; ++i) {
+      obs.ids.push_back(first_id + i);
+      obs.points.push_back({-1.0 + 0.07 * i, -0.5 + (i * 7 % 10) * 0.1, z});
+    }
+    return obs;
+  };
+  auto floor = [](std::uint64_t first_id, unsigned k) {  // y = 0.8 (core frame: y down)
+    PlaneObservation obs;
+    obs.viewpoint = {0.3 * k, 0, 0};
+    for (int i = 0; i < 30; ++i) {
+      obs.ids.push_back(first_id + i);
+      obs.points.push_back({-1.0 + 0.07 * i, 0.8, 1.0 + (i * 7 % 10) * 0.1});
+    }
+    return obs;
+  };
+  for (unsigned k = 0; k < 5; ++k)
+    map.update({wall(2.0, 0.0, 100, k), wall(-2.0, 0.0, 300, k), floor(500, k)}, 10.0 + k);
+  ASSERT_EQ(map.planes().size(), 3u);
+  std_msgs::Header header;
+  header.frame_id = "plane_map";
+  std::set<int> shown;
+  const visualization_msgs::MarkerArrayPtr markers = toMarkers(header, map, shown);
+  std::map<int, cv::Vec3d> normal_of;
+  for (const auto& m : markers->markers)
+    if (m.ns == "normals")
+      normal_of[m.id] = cv::Vec3d(m.points[1].x - m.points[0].x, m.points[1].y - m.points[0].y,
+                                  m.points[1].z - m.points[0].z);
+  int triangles = 0;
+  for (const auto& m : markers->markers) {
+    if (m.ns != "planes") continue;
+    ASSERT_TRUE(normal_of.count(m.id));
+    ASSERT_EQ(m.points.size() % 6, 0u);
+    auto v = [&](size_t i) { return cv::Vec3d(m.points[i].x, m.points[i].y, m.points[i].z); };
+    auto facing = [&](size_t t) {
+      return (v(t + 1) - v(t)).cross(v(t + 2) - v(t)).dot(normal_of[m.id]);
+    };
+    for (size_t t = 0; t < m.points.size(); t += 6) {
+      EXPECT_LT(facing(t), 0) << "plane " << m.id << ", triangle " << t / 3;
+      EXPECT_GT(facing(t + 3), 0) << "plane " << m.id << ", triangle " << t / 3 + 1;
+      ++triangles;
+    }
+  }
+  EXPECT_GE(triangles, 9);
 }
