@@ -89,12 +89,13 @@ fuzz: deps link
 test: build
 	@rm -rf $(WS)/build/test_results
 	@# The test programs first, JOBS at a time (run_tests -j1 would build them one by one);
-	@# the gtests JOBS at a time too (no ROS master, nothing timed); the rostests one by one
-	@# (each replays images in real time through a manager and must keep up).
+	@# the gtests JOBS at a time too (no ROS master, nothing timed); then the rostests and
+	@# launch checks, two at a time, the longest first (scripts/run_rostests.sh: each
+	@# replays images in real time through its own manager and master, about half a core).
 	@$(CATKIN) tests > $(WS)/build_tests.log 2>&1 || { tail -40 $(WS)/build_tests.log; exit 1; }
 	@$(CATKIN) run_tests_mono_plane_detection_gtest > $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
-	@$(CATKIN) run_tests_mono_plane_detection_rostest run_tests_mono_plane_detection_roslaunch-check -j1 \
-	  >> $(WS)/run_tests.log 2>&1 || { tail -50 $(WS)/run_tests.log; exit 1; }
+	@source $(DEVEL) && scripts/run_rostests.sh $(WS)/build 2 >> $(WS)/run_tests.log 2>&1 \
+	  || { tail -50 $(WS)/run_tests.log; exit 1; }
 	@scripts/summarize_tests.sh $(WS)/build/test_results
 
 # The suite (ours against baselines, plot in $(RESULTS)/benchmark.png) and the latency
