@@ -579,7 +579,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool fromBeforeClockJump(const ros::Time& stamp) {
     const ros::Time now = ros::Time::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    if (now < clock_seen_) jumped_from_ = clock_seen_;
+    if (now < clock_seen_) {
+      jumped_from_ = clock_seen_;
+      clock_went_back_ = true;
+    }
     clock_seen_ = now;
     if (jumped_from_.isZero()) return false;
     if (stamp.toSec() > 0.5 * (now.toSec() + jumped_from_.toSec())) return true;
@@ -668,7 +671,14 @@ class PlaneNodelet : public nodelet::Nodelet {
         mapStartedOver();
         ++resets_;
         ++backwards_resets_;
+        // The listener cleared its buffer when it saw the clock go back, then took in what
+        // was queued before the jump: our own transform of the previous loop's last images
+        // among it (measured: 59 TF_OLD_DATA in a loop of the room bag with the stale
+        // tracks above kept off tf). Cleared again now that the tracks agree (tf2_ros's
+        // own remedy; the static links stay): the new loop's odometry refills it.
+        if (clock_went_back_ && tf_buffer_) tf_buffer_->clear();
       }
+      if (!before_jump) clock_went_back_ = false;  // (kept over the previous loop's tracks)
       if (result.tracking_loss && logNow("tracking loss", 5.0))
         NODELET_WARN("%.1f s without tracks: tracking lost, waiting for %s to place the camera "
                      "again",
@@ -858,6 +868,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   double waited_before_s_ = 0;   // in earlier stretches of the stream (tracks stamps), s
   std::string odom_tf_problem_;  // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
+  bool clock_went_back_ = false;        // since the last tracks (fromBeforeClockJump)
   RecentEvents logged_;  // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
   bool reset_markers_ = false;
