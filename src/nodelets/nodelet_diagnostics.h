@@ -102,8 +102,9 @@ class StatusProblems {
       status.summary(diagnostic_msgs::DiagnosticStatus::OK, ok_text);
     status.add("problems now", problems_.size());
     for (const Problem& p : problems_)
-      status.add("problem: " + p.key, (p.level == diagnostic_msgs::DiagnosticStatus::ERROR ? "ERROR: " : "WARN: ") +
-                            p.text);
+      status.add(
+          "problem: " + p.key,
+          (p.level == diagnostic_msgs::DiagnosticStatus::ERROR ? "ERROR: " : "WARN: ") + p.text);
   }
 
  private:

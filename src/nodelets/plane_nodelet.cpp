@@ -277,9 +277,7 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   // A log line at most once per period_s of wall time per kind: ROS's _THROTTLE macros
   // count in ros::Time, which a looping bag sets back, silencing them for a whole loop.
-  bool logNow(const std::string& kind, double period_s) {
-    return logged_.note(kind, "", period_s);
-  }
+  bool logNow(const std::string& kind, double period_s) { return logged_.note(kind, "", period_s); }
 
   bool onSaveMap(SaveMap::Request& req, SaveMap::Response& res) {
     guard_.run("save_map", [&] {
@@ -366,8 +364,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   // a frame of the robot's tf (a driver's frame_id against another URDF name) is not the
   // odometry's fault.
   std::string odometryTfProblem(const std::string& camera) const {
-    const std::string fix = ": the images' header.frame_id must be a tf frame of the robot "
-                            "(its URDF), linked to odom_frame '" + odom_frame_ + "'";
+    const std::string fix =
+        ": the images' header.frame_id must be a tf frame of the robot "
+        "(its URDF), linked to odom_frame '" +
+        odom_frame_ + "'";
     if (camera.empty()) return "the images have an empty frame_id" + fix;
     if (!tf_buffer_->_frameExists(camera))
       return "camera frame '" + camera + "' (the images' header.frame_id) is not in the tf tree" +
@@ -375,8 +375,10 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!tf_buffer_->_frameExists(odom_frame_))
       return "odom_frame '" + odom_frame_ + "' is not on tf: no odometry published (yet)";
     if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0)))
-      return "camera frame '" + camera + "' (the images' header.frame_id) is not connected to "
-             "odom_frame '" + odom_frame_ + "' on tf" + fix;
+      return "camera frame '" + camera +
+             "' (the images' header.frame_id) is not connected to "
+             "odom_frame '" +
+             odom_frame_ + "' on tf" + fix;
     return {};
   }
 
@@ -642,7 +644,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         }
       } else if (has_info_) {
         pipeline_->setCamera(camera_.K, camera_.D);  // (checked on arrival; same: no change)
-        undistortFisheye(frame, camera_);  // equidistant: pinhole pixels of the same K
+        undistortFisheye(frame, camera_);            // equidistant: pinhole pixels of the same K
       } else if (logNow("no camera_info", 10.0)) {
         NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
                      info_sub_.getTopic().c_str());
@@ -680,10 +682,10 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       if (!before_jump) clock_went_back_ = false;  // (kept over the previous loop's tracks)
       if (result.tracking_loss && logNow("tracking loss", 5.0))
-        NODELET_WARN("%.1f s without tracks: tracking lost, waiting for %s to place the camera "
-                     "again",
-                     params_.max_gap_s,
-                     odom_frame_.empty() ? "the map or the target" : "the odometry");
+        NODELET_WARN(
+            "%.1f s without tracks: tracking lost, waiting for %s to place the camera "
+            "again",
+            params_.max_gap_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
@@ -760,19 +762,23 @@ class PlaneNodelet : public nodelet::Nodelet {
     const long exceptions = guard_.count();
     // The present state first, then what happened lately; the summary is the most severe.
     StatusProblems problems;
-    if (!tf_conflict_.empty()) problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
+    if (!tf_conflict_.empty())
+      problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
     if (!target_mismatch_.empty())
-      problems.add(DiagnosticStatus::ERROR, "start-up target", "start-up target: " + target_mismatch_);
+      problems.add(DiagnosticStatus::ERROR, "start-up target",
+                   "start-up target: " + target_mismatch_);
     // (Now: a camera_info or tracks of the right size clear it at once.)
     if (has_info_ && !last_tracks_size_.empty())
       if (const std::string mismatch = infoSizeMismatch(camera_.size, last_tracks_size_);
           !mismatch.empty())
         problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
     if (frames_ > 0 && !has_info_)
-      problems.add(DiagnosticStatus::WARN, "camera_info", "tracks arrive but no usable camera_info");
+      problems.add(DiagnosticStatus::WARN, "camera_info",
+                   "tracks arrive but no usable camera_info");
     if (state_ == PipelineState::kLost)
-      problems.add(DiagnosticStatus::WARN, "tracking",
-                   status_.rfind("lost", 0) == 0 ? "tracking " + status_ : "tracking lost: " + status_);
+      problems.add(
+          DiagnosticStatus::WARN, "tracking",
+          status_.rfind("lost", 0) == 0 ? "tracking " + status_ : "tracking lost: " + status_);
     if (!odom_tf_problem_.empty())
       problems.add(DiagnosticStatus::WARN, "odometry", "no odometry: " + odom_tf_problem_);
     else if (odometry_stopped_)
@@ -862,14 +868,14 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;
   CameraIntrinsics camera_;
-  bool has_info_ = false;  // camera_ holds a usable camera_info
-  long info_size_mismatch_ = 0;  // tracks it was not used for (another image size)
-  long backwards_resets_ = 0;    // map resets because time went backwards
-  double waited_before_s_ = 0;   // in earlier stretches of the stream (tracks stamps), s
-  std::string odom_tf_problem_;  // why tf links no odometry to the last tracks' camera
+  bool has_info_ = false;               // camera_ holds a usable camera_info
+  long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
+  long backwards_resets_ = 0;           // map resets because time went backwards
+  double waited_before_s_ = 0;          // in earlier stretches of the stream (tracks stamps), s
+  std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   bool clock_went_back_ = false;        // since the last tracks (fromBeforeClockJump)
-  RecentEvents logged_;  // log throttles on wall time (logNow)
+  RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
   bool reset_markers_ = false;
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;

@@ -37,7 +37,8 @@ class RecentEvents {
     const ros::WallTime now = ros::WallTime::now();
     std::vector<std::pair<ros::WallTime, const std::pair<const std::string, Event>*>> found;
     for (const auto& entry : events_)
-      if ((now - entry.second.last).toSec() <= window_s) found.push_back({entry.second.last, &entry});
+      if ((now - entry.second.last).toSec() <= window_s)
+        found.push_back({entry.second.last, &entry});
     std::sort(found.begin(), found.end(),
               [](const auto& a, const auto& b) { return a.first > b.first; });
     std::vector<std::pair<std::string, std::string>> out;

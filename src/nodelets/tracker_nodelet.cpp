@@ -216,7 +216,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     // The present state first, then what happened lately (drops and camera switches count
     // for the level while recent: the totals stay below).
     StatusProblems problems;
-    if (!subscribe_error_.empty()) problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
+    if (!subscribe_error_.empty())
+      problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
     if (const std::string mismatch = front_.infoMismatch(); !mismatch.empty())
       problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
     if (!subscribed_at_.isZero()) {
@@ -249,7 +250,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("camera switches (total)", c.camera_switches);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera_info", !front_.hasCameraInfo()           ? "none or unusable"
+    status.add("camera_info", !front_.hasCameraInfo()          ? "none or unusable"
                               : !front_.infoMismatch().empty() ? "for another image size: not used"
                                                                : "ok");
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
@@ -289,8 +290,8 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::ServiceServer reset_srv_;
   ros::WallTime first_image_;  // wall: diagnostics must hold under sim time
   ros::WallTime last_image_;
-  ros::WallTime subscribed_at_;  // zero while not subscribed (lazy, nobody listens)
-  std::string image_topic_;      // resolved
+  ros::WallTime subscribed_at_;              // zero while not subscribed (lazy, nobody listens)
+  std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;

@@ -224,21 +224,24 @@ TEST(TwoCameras, ABagLoopStartsTheMapOverWithoutTheOldLoopsTf) {
   ros::Publisher tracks = nh.advertise<Tracks>("/front/tracks", 20);
   Answers planes(nh, "/front/planes");
   std::set<uint64_t> tf_stamps;  // of front_map's transforms
-  ros::Subscriber tf = nh.subscribe<tf2_msgs::TFMessage>(
-      "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+  ros::Subscriber tf =
+      nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
         for (const auto& t : m->transforms)
           if (t.header.frame_id == "front_map") tf_stamps.insert(t.header.stamp.toNSec());
       });
   int starts_over = 0;
-  ros::Subscriber rosout = nh.subscribe<rosgraph_msgs::Log>(
-      "/rosout", 100, [&](const rosgraph_msgs::LogConstPtr& m) {
+  ros::Subscriber rosout =
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 100, [&](const rosgraph_msgs::LogConstPtr& m) {
         starts_over += m->name.rfind("/front/", 0) == 0 &&
                        m->msg.find("the map starts over") != std::string::npos;
       });
   DiagnosticsProbe status(nh, "front/plane_detector: planes");
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0 &&
-                         tf.getNumPublishers() > 0; },
-            10.0);
+  spinUntil(
+      [&] {
+        return tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0 &&
+               tf.getNumPublishers() > 0;
+      },
+      10.0);
   ASSERT_TRUE(status.waitFresh());  // (and /rosout linked meanwhile)
   const long backwards = status.number("resets: time went backwards (total)");
   auto sendAt = [&](int k, double clock_t) {  // tracks of image k, /clock at clock_t
@@ -261,13 +264,15 @@ TEST(TwoCameras, ABagLoopStartsTheMapOverWithoutTheOldLoopsTf) {
     // The clock goes back to the start; tracks of the previous loop's last image come late.
     const PlaneArrayConstPtr late = sendAt(end, 0.0);
     ASSERT_TRUE(late) << "loop " << loop;
-    for (int k = 0; k < 10; ++k) ASSERT_TRUE(sendAt(k, k / 30.0)) << "loop " << loop << " image " << k;
+    for (int k = 0; k < 10; ++k)
+      ASSERT_TRUE(sendAt(k, k / 30.0)) << "loop " << loop << " image " << k;
     spinUntil([&] { return starts_over >= loop; }, 3.0);
     EXPECT_EQ(starts_over, loop) << "\"the map starts over\" in loop " << loop;
     EXPECT_FALSE(tf_stamps.count(late->header.stamp.toNSec()))
         << "tf with the previous loop's stamp, loop " << loop;
     end = 240;  // a loop of 8 s: metric again by its end (the stale tracks above were)
-    for (int k = 10; k < end; ++k) ASSERT_TRUE(sendAt(k, k / 30.0)) << "loop " << loop << " image " << k;
+    for (int k = 10; k < end; ++k)
+      ASSERT_TRUE(sendAt(k, k / 30.0)) << "loop " << loop << " image " << k;
   }
   ASSERT_TRUE(status.waitFresh());
   EXPECT_EQ(status.number("resets: time went backwards (total)"), backwards + 2);
