@@ -125,6 +125,17 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
   return fromCameraInfo(info, out.K, out.D);
 }
 
+std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size) {
+  if (info_size == image_size) return {};
+  std::ostringstream why;
+  why << "camera_info is for " << info_size.width << "x" << info_size.height
+      << " images but the images are " << image_size.width << "x" << image_size.height
+      << ": not used for them (planes stay in image space); publish the camera's binning_x/y "
+         "or ROI in camera_info, or a calibration made at "
+      << image_size.width << "x" << image_size.height;
+  return why.str();
+}
+
 bool isRectifiedTopic(const std::string& topic) {
   const std::string base = topic.substr(topic.find_last_of('/') + 1);
   return base.rfind("image_rect", 0) == 0;

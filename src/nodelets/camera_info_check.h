@@ -39,6 +39,11 @@ struct CameraIntrinsics {
 std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool rectified,
                                      CameraIntrinsics& out);
 
+// Empty when a camera_info describing images of `info_size` (binning and ROI applied:
+// CameraIntrinsics::size) is these images' camera, else the ERROR both nodelets give: it
+// names both sizes and what to do. Such a camera_info is not used for those images.
+std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size);
+
 // A rectified stream by its topic's name: image_proc calls it image_rect (or image_rect_color).
 bool isRectifiedTopic(const std::string& resolved_image_topic);
 

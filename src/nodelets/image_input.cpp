@@ -26,6 +26,25 @@ sensor_msgs::ImageConstPtr littleEndian(const sensor_msgs::ImageConstPtr& msg) {
   return copy;
 }
 
+// A known encoding without grey levels (depth, disparity: 16UC1, 32FC1, ...): cv_bridge
+// refuses it with "[16UC1] is not a color format. but [mono8] is. The conversion does not
+// make sense", which a user at the robot does not read as "wrong topic".
+bool isDataEncoding(const std::string& encoding) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (enc::isColor(encoding) || enc::isMono(encoding) || enc::isBayer(encoding)) return false;
+  try {
+    return enc::bitDepth(encoding) > 0;  // (throws for unknown ones)
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+std::string dataEncodingAdvice(const std::string& encoding) {
+  return "depth or other single-value images (" + encoding +
+         ") are not supported; use the camera's grey or colour image (mono8/mono16 or bgr8), "
+         "not its depth";
+}
+
 }  // namespace
 
 GreyImage toGrey(const sensor_msgs::ImageConstPtr& msg) {
@@ -47,7 +66,8 @@ GreyImage toGrey(const sensor_msgs::ImageConstPtr& msg) {
   try {
     out.image = cv_bridge::toCvShare(littleEndian(msg), sensor_msgs::image_encodings::MONO8);
   } catch (const cv_bridge::Exception& e) {
-    out.error = "unsupported encoding '" + msg->encoding + "': " + e.what();
+    out.error = "unsupported encoding '" + msg->encoding + "': " +
+                (isDataEncoding(msg->encoding) ? dataEncodingAdvice(msg->encoding) : e.what());
     return out;
   } catch (const cv::Exception& e) {
     out.error = "cannot convert encoding '" + msg->encoding + "' to mono8: " + e.what();

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "callback_guard.h"
 
@@ -78,6 +79,40 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
   ros::WallTime started_;
   long total_ = 0;
   bool idle_ = false;
+};
+
+// Every problem a status has now, each under a key of its own ("problem: <key>": none
+// hides another); the
+// summary is the most severe, the first added of equal ones (callers add the present
+// state before what happened lately).
+class StatusProblems {
+ public:
+  void add(unsigned char level, const std::string& key, const std::string& text) {
+    problems_.push_back({level, key, text});
+  }
+
+  void report(diagnostic_updater::DiagnosticStatusWrapper& status,
+              const std::string& ok_text) const {
+    const Problem* worst = nullptr;
+    for (const Problem& p : problems_)
+      if (!worst || p.level > worst->level) worst = &p;
+    if (worst)
+      status.summary(worst->level, worst->text);
+    else
+      status.summary(diagnostic_msgs::DiagnosticStatus::OK, ok_text);
+    status.add("problems now", problems_.size());
+    for (const Problem& p : problems_)
+      status.add(
+          "problem: " + p.key,
+          (p.level == diagnostic_msgs::DiagnosticStatus::ERROR ? "ERROR: " : "WARN: ") + p.text);
+  }
+
+ private:
+  struct Problem {
+    unsigned char level;
+    std::string key, text;
+  };
+  std::vector<Problem> problems_;
 };
 
 class NodeletDiagnostics {

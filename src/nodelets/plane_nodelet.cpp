@@ -28,6 +28,7 @@
 #include "camera_info_check.h"
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/SaveMap.h"
+#include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
 #include "mono_plane_detection/viz/draw_planes.h"
@@ -227,11 +228,13 @@ class PlaneNodelet : public nodelet::Nodelet {
     while (images_.size() > 10) images_.pop_front();
   }
 
+  // Kept, and given to the pipeline with the next tracks of its image size (process()):
+  // a camera_info for another size is not used for those tracks.
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& msg) {
     CameraIntrinsics camera;
     std::string error = intrinsicsFromCameraInfo(*msg, rectified_, camera);
+    if (error.empty()) error = cameraIntrinsicsError(camera.K, camera.D);
     std::lock_guard<std::mutex> lock(mutex_);
-    if (error.empty()) error = pipeline_->setCamera(camera.K, camera.D);
     if (!error.empty()) {
       ++dropped_info_;
       // One throttle per reason: an unknown distortion model after a zero K is named too.
@@ -239,8 +242,8 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN("camera_info rejected: %s; image-space planes only", error.c_str());
       return;
     }
-    camera_ = camera;
-    info_size_ = camera.size;  // (binning and ROI applied)
+    camera_ = camera;  // (its size with binning and ROI applied)
+    has_info_ = true;
   }
 
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -252,19 +255,29 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       std::lock_guard<std::mutex> lock(mutex_);
       pipeline_->reset();
-      markers_shown_.clear();
-      reset_markers_ = true;
+      mapStartedOver();
       last_odom_.reset();
       last_planes_.reset();
       tf_conflict_.clear();
       resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
-      waiting_since_ = -1;
       ++resets_;
       NODELET_INFO("reset: the map and the camera pose start over");
       done = true;
     });
     return done;
   }
+
+  // What the map's output keeps beyond the pipeline, started over with it (mutex_ held).
+  void mapStartedOver() {
+    markers_shown_.clear();
+    reset_markers_ = true;
+    waiting_since_ = -1;
+    waited_before_s_ = waited_s_ = 0;
+  }
+
+  // A log line at most once per period_s of wall time per kind: ROS's _THROTTLE macros
+  // count in ros::Time, which a looping bag sets back, silencing them for a whole loop.
+  bool logNow(const std::string& kind, double period_s) { return logged_.note(kind, "", period_s); }
 
   bool onSaveMap(SaveMap::Request& req, SaveMap::Response& res) {
     guard_.run("save_map", [&] {
@@ -306,7 +319,10 @@ class PlaneNodelet : public nodelet::Nodelet {
     return true;  // the reason is in the response
   }
 
-  std::optional<Pose> odometry(const std_msgs::Header& header) {
+  // tf_problem: why tf links no odometry to these tracks' camera at all ("" when it does,
+  // or when only this stamp is missing: the odometry stopped or is late).
+  std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem) {
+    tf_problem.clear();
     if (odom_frame_.empty()) return {};
     try {
       // Never wait in a callback: drain() waited (odom_wait_s) without blocking; now
@@ -325,18 +341,45 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (!error.empty()) {
         ++refused_odom_;
         problems_.note("odometry refused", "odometry refused: " + error);
-        NODELET_WARN_THROTTLE(5.0, "odometry %s -> %s at %.3f refused (%s): visual pose used",
-                              odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
-                              error.c_str());
+        if (logNow("odometry refused", 5.0))
+          NODELET_WARN("odometry %s -> %s at %.3f refused (%s): visual pose used",
+                       odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
+                       error.c_str());
         return {};
       }
       return odom;
     } catch (const tf2::TransformException& e) {
-      NODELET_WARN_THROTTLE(10.0, "no %s -> %s transform at %.3f (%s): visual pose only",
-                            odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(),
-                            e.what());
+      tf_problem = odometryTfProblem(tfFrame(header.frame_id));
+      if (!tf_problem.empty() ? logNow("odometry tf " + tf_problem, 10.0)
+                              : logNow("odometry lookup", 10.0))
+        NODELET_WARN("no %s -> %s transform at %.3f (%s): visual pose only%s%s",
+                     odom_frame_.c_str(), header.frame_id.c_str(), header.stamp.toSec(), e.what(),
+                     tf_problem.empty() ? "" : "; ", tf_problem.c_str());
       return {};
     }
+  }
+
+  // Why tf cannot link odom_frame to the camera at any time, "" when it can (then only
+  // the image's stamp is missing: odometry stopped or late). A camera frame that is not
+  // a frame of the robot's tf (a driver's frame_id against another URDF name) is not the
+  // odometry's fault.
+  std::string odometryTfProblem(const std::string& camera) const {
+    const std::string fix =
+        ": the images' header.frame_id must be a tf frame of the robot "
+        "(its URDF), linked to odom_frame '" +
+        odom_frame_ + "'";
+    if (camera.empty()) return "the images have an empty frame_id" + fix;
+    if (!tf_buffer_->_frameExists(camera))
+      return "camera frame '" + camera + "' (the images' header.frame_id) is not in the tf tree" +
+             fix;
+    if (!tf_buffer_->_frameExists(odom_frame_))
+      return "odom_frame '" + odom_frame_ + "' is not on tf: no odometry published (yet)";
+    if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0)))
+      return "camera frame '" + camera +
+             "' (the images' header.frame_id) is not connected to "
+             "odom_frame '" +
+             odom_frame_ + "' on tf" + fix;
+    return {};
   }
 
   // Why publishing parent -> child would break the tf tree (REP 105), "" when it would
@@ -415,7 +458,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
     } else {
       if (header.frame_id.empty()) {
-        NODELET_WARN_THROTTLE(10.0, "tracks have an empty frame_id: no camera estimate on tf");
+        if (logNow("empty frame_id", 10.0))
+          NODELET_WARN("tracks have an empty frame_id: no camera estimate on tf");
         return {};
       }
       // Never the camera's own frame: the robot's URDF is its parent already.
@@ -529,10 +573,32 @@ class PlaneNodelet : public nodelet::Nodelet {
     return odometry_live_;
   }
 
+  // Whether tracks come from before a jump back of ros::Time (a bag loop): tf2_ros's
+  // listener cleared its buffer at the jump, and a transform stamped at the previous
+  // loop's end filled it with times the new loop's first 10 s are too old for (tf2's
+  // cache: ~60 TF_OLD_DATA warnings per loop). Such tracks have stamps nearer the clock
+  // before the jump than the clock now; the first that does not ends the jump.
+  bool fromBeforeClockJump(const ros::Time& stamp) {
+    const ros::Time now = ros::Time::now();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (now < clock_seen_) {
+      jumped_from_ = clock_seen_;
+      clock_went_back_ = true;
+    }
+    clock_seen_ = now;
+    if (jumped_from_.isZero()) return false;
+    if (stamp.toSec() > 0.5 * (now.toSec() + jumped_from_.toSec())) return true;
+    jumped_from_ = ros::Time();
+    return false;
+  }
+
   // frame: msg's tracks, checked on arrival (toTrackFrame).
   void process(const Tracks& msg, TrackFrame frame) {
     const ros::WallTime started = ros::WallTime::now();
-    const std::optional<Pose> odom = odometry(msg.header);
+    const bool before_jump = fromBeforeClockJump(msg.header.stamp);
+    std::string odom_tf_problem;
+    const std::optional<Pose> odom =
+        before_jump ? std::nullopt : odometry(msg.header, odom_tf_problem);
     PlaneArrayPtr planes, image_planes;
     geometry_msgs::PoseStampedPtr pose;
     visualization_msgs::MarkerArrayPtr markers;
@@ -562,23 +628,27 @@ class PlaneNodelet : public nodelet::Nodelet {
       // the tracker's target, so a tracker relaunched with the right one clears it at once.
       target_mismatch_ = targetMismatch(msg, node_.pipeline.target);
       if (!target_mismatch_.empty()) {
-        NODELET_ERROR_THROTTLE(10.0, "%s", target_mismatch_.c_str());
+        if (logNow("target mismatch", 10.0)) NODELET_ERROR("%s", target_mismatch_.c_str());
         frame.target_corner.assign(frame.target_corner.size(), false);
       }
-      // (Its size with binning and ROI applied: the images it describes.) Tracks that mix
-      // cameras explain a size that differs: that is said instead.
-      if (!info_size_.empty() && info_size_ != frame.size &&
-          !problems_.happened(kCameraSwitch, kRecentS)) {
-        const std::string why = "camera_info is for " + sizeText(info_size_) +
-                                " images but tracks are of " + sizeText(frame.size);
-        if (problems_.note("camera_info size", why, 10.0)) NODELET_WARN("%s", why.c_str());
+      // The camera_info describes tracks of its image size only (binning and ROI applied):
+      // for others the pipeline has no camera (image-space planes, no target pose from it),
+      // and the next tracks of its size use it at once.
+      const std::string info_mismatch = has_info_ ? infoSizeMismatch(camera_.size, frame.size) : "";
+      if (!info_mismatch.empty()) {
+        ++info_size_mismatch_;
+        if (logNow("info size", 10.0)) NODELET_ERROR("%s", info_mismatch.c_str());
+        if (pipeline_->hasCamera()) {  // (the map of that camera does not apply)
+          pipeline_ = std::make_unique<PlanePipeline>(params_);
+          mapStartedOver();
+        }
+      } else if (has_info_) {
+        pipeline_->setCamera(camera_.K, camera_.D);  // (checked on arrival; same: no change)
+        undistortFisheye(frame, camera_);            // equidistant: pinhole pixels of the same K
+      } else if (logNow("no camera_info", 10.0)) {
+        NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
+                     info_sub_.getTopic().c_str());
       }
-      if (!pipeline_->hasCamera())
-        NODELET_WARN_THROTTLE(10.0,
-                              "tracks arrive but no usable camera_info on %s: image-space "
-                              "planes only",
-                              info_sub_.getTopic().c_str());
-      undistortFisheye(frame, camera_);  // equidistant: pinhole pixels of the same K
       // The core's axes (y up) for the odometry: with metric_source odometry the ROS map
       // is then the odometry frame itself (docs/ros_interface.md).
       const PipelineResult result =
@@ -588,33 +658,51 @@ class PlaneNodelet : public nodelet::Nodelet {
       // The tf of the odometry source stopped: vision carries the pose (landmarks in the
       // odometry's frame, so no jump), said in diagnostics.
       // Any source: without odometry no map <-> odom tf is published for the image.
-      odometry_stopped_ = !odom && !odom_frame_.empty();
+      // (Tracks of before a jump back of the clock say nothing of the odometry now.)
+      if (!before_jump) {
+        odom_tf_problem_ = odom_tf_problem;
+        odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
+      }
       if (result.was_reset) {
-        NODELET_WARN_THROTTLE(
-            5.0,
+        // Rare (a bag loop): every time, whatever the clock did (a throttle on ros::Time
+        // was silenced by the loop itself).
+        NODELET_WARN(
             "tracks stamp %.3f is before the previous one: time went backwards (bag "
             "loop?), the map starts over",
             frame.stamp);
-        markers_shown_.clear();
-        reset_markers_ = true;
-        waiting_since_ = -1;
+        mapStartedOver();
+        ++resets_;
+        ++backwards_resets_;
+        // The listener cleared its buffer when it saw the clock go back, then took in what
+        // was queued before the jump: our own transform of the previous loop's last images
+        // among it (measured: 59 TF_OLD_DATA in a loop of the room bag with the stale
+        // tracks above kept off tf). Cleared again now that the tracks agree (tf2_ros's
+        // own remedy; the static links stay): the new loop's odometry refills it.
+        if (clock_went_back_ && tf_buffer_) tf_buffer_->clear();
       }
-      if (result.tracking_loss)
-        NODELET_WARN_THROTTLE(5.0,
-                              "%.1f s without tracks: tracking lost, waiting for %s to place "
-                              "the camera again",
-                              params_.max_gap_s,
-                              odom_frame_.empty() ? "the map or the target" : "the odometry");
+      if (!before_jump) clock_went_back_ = false;  // (kept over the previous loop's tracks)
+      if (result.tracking_loss && logNow("tracking loss", 5.0))
+        NODELET_WARN(
+            "%.1f s without tracks: tracking lost, waiting for %s to place the camera "
+            "again",
+            params_.max_gap_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
       }
+      // Waited in tracks stamps over the stretches of the stream: a pause or a jump of the
+      // stamps (another bag, a driver's clock) closes one and is no waiting (it said
+      // "not seen for 100000011 s" after stamps jumped forward).
       if (result.state == PipelineState::kWaitingForTarget) {
+        if (result.tracking_loss && waiting_since_ >= 0) {
+          waited_before_s_ = waited_s_;
+          waiting_since_ = -1;
+        }
         if (waiting_since_ < 0) waiting_since_ = frame.stamp;
-        waited_s_ = frame.stamp - waiting_since_;
+        waited_s_ = waited_before_s_ + (frame.stamp - waiting_since_);
       } else {
         waiting_since_ = -1;
-        waited_s_ = 0;
+        waited_before_s_ = waited_s_ = 0;
       }
       ++frames_;
       status_ = result.status;
@@ -642,7 +730,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         }
         if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
           cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
-        tf = transformFor(ros_map_from_camera, odom, msg.header);
+        if (!before_jump) tf = transformFor(ros_map_from_camera, odom, msg.header);
       }
       last_planes_ = planes;
       if (debug_pub_.getNumSubscribers() > 0) {
@@ -651,7 +739,7 @@ class PlaneNodelet : public nodelet::Nodelet {
             try {
               drawing = drawPlanes(cv_bridge::toCvShare(image, "mono8")->image, result);
             } catch (const cv_bridge::Exception& e) {
-              NODELET_WARN_THROTTLE(10.0, "cannot draw on the image: %s", e.what());
+              if (logNow("draw", 10.0)) NODELET_WARN("cannot draw on the image: %s", e.what());
             }
           }
       }
@@ -672,39 +760,43 @@ class PlaneNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     using diagnostic_msgs::DiagnosticStatus;
     const long exceptions = guard_.count();
-    const bool no_camera = frames_ > 0 && !pipeline_->hasCamera();
-    const bool target_late =
-        state_ == PipelineState::kWaitingForTarget && waited_s_ > target_timeout_s_;
-    const bool lost = state_ == PipelineState::kLost;
+    // The present state first, then what happened lately; the summary is the most severe.
+    StatusProblems problems;
     if (!tf_conflict_.empty())
-      status.summary(DiagnosticStatus::ERROR, "tf conflict: " + tf_conflict_);
-    else if (!target_mismatch_.empty())
-      status.summary(DiagnosticStatus::ERROR, "start-up target: " + target_mismatch_);
-    else if (no_camera)  // the present state first, then what happened since the start
-      status.summary(DiagnosticStatus::WARN, "tracks arrive but no usable camera_info");
-    else if (lost)
-      status.summary(DiagnosticStatus::WARN, status_.rfind("lost", 0) == 0
-                                                 ? "tracking " + status_
-                                                 : "tracking lost: " + status_);
+      problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
+    if (!target_mismatch_.empty())
+      problems.add(DiagnosticStatus::ERROR, "start-up target",
+                   "start-up target: " + target_mismatch_);
+    // (Now: a camera_info or tracks of the right size clear it at once.)
+    if (has_info_ && !last_tracks_size_.empty())
+      if (const std::string mismatch = infoSizeMismatch(camera_.size, last_tracks_size_);
+          !mismatch.empty())
+        problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
+    if (frames_ > 0 && !has_info_)
+      problems.add(DiagnosticStatus::WARN, "camera_info",
+                   "tracks arrive but no usable camera_info");
+    if (state_ == PipelineState::kLost)
+      problems.add(
+          DiagnosticStatus::WARN, "tracking",
+          status_.rfind("lost", 0) == 0 ? "tracking " + status_ : "tracking lost: " + status_);
+    if (!odom_tf_problem_.empty())
+      problems.add(DiagnosticStatus::WARN, "odometry", "no odometry: " + odom_tf_problem_);
     else if (odometry_stopped_)
-      status.summary(DiagnosticStatus::WARN,
-                     "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: " +
-                         (metric_source_ == "odometry"
-                              ? std::string("camera pose from vision only")
-                              : "no " + map_frame_ + " <-> " + odom_frame_ +
-                                    " tf for these images"));
-    else if (target_late)
-      status.summary(DiagnosticStatus::WARN,
-                     (node_.pipeline.pose.metric_source == "target"
-                          ? "start-up target not seen for "
-                          : "no metric start (" + status_ + ") for ") +
-                         std::to_string(static_cast<int>(waited_s_)) + " s");
-    else if (exceptions > 0)
-      status.summary(DiagnosticStatus::WARN, "exceptions caught");
-    else if (const std::string recent = problems_.recent(kRecentS); !recent.empty())
-      status.summary(DiagnosticStatus::WARN, recent);  // while recent; the totals stay below
-    else
-      status.summary(DiagnosticStatus::OK, status_.empty() ? "no tracks yet" : status_);
+      problems.add(DiagnosticStatus::WARN, "odometry",
+                   "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: " +
+                       (metric_source_ == "odometry"
+                            ? std::string("camera pose from vision only")
+                            : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
+    if (state_ == PipelineState::kWaitingForTarget && waited_s_ > target_timeout_s_)
+      problems.add(DiagnosticStatus::WARN, "metric start",
+                   (node_.pipeline.pose.metric_source == "target"
+                        ? "start-up target not seen for "
+                        : "no metric start (" + status_ + ") for ") +
+                       std::to_string(static_cast<long>(waited_s_)) + " s");
+    if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
+    for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
+      problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
+    problems.report(status, status_.empty() ? "no tracks yet" : status_);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
     status.add("camera switches (total)", camera_switches_);
@@ -724,7 +816,10 @@ class PlaneNodelet : public nodelet::Nodelet {
                                            : tf_edge_);
     status.add("metric source", metric_source_.empty() ? "none yet (" + node_.pipeline.pose.metric_source + ")"
                                                        : metric_source_);
+    status.add("tracks with camera_info of another size (total)", info_size_mismatch_);
+    // Every start over of the map: ~reset calls and time going backwards (a bag loop).
     status.add("resets (total)", resets_);
+    status.add("resets: time went backwards (total)", backwards_resets_);
     status.add("reconfigurations (total)", reconfigures_);
     status.add("planes in this image", observed_);
     status.add("planes in the map", pipeline_->map().planes().size());
@@ -773,7 +868,14 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;
   CameraIntrinsics camera_;
-  cv::Size info_size_;
+  bool has_info_ = false;               // camera_ holds a usable camera_info
+  long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
+  long backwards_resets_ = 0;           // map resets because time went backwards
+  double waited_before_s_ = 0;          // in earlier stretches of the stream (tracks stamps), s
+  std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
+  ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
+  bool clock_went_back_ = false;        // since the last tracks (fromBeforeClockJump)
+  RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
   bool reset_markers_ = false;
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;

@@ -1,15 +1,18 @@
 // What went wrong lately, per kind: a log throttle per kind (one kind never hides
 // another: a 32FC1 image right after a 16UC1 one is logged too), the last text of each
-// kind for diagnostics, and whether it happened within a window (a diagnostics WARN ends
-// a while after its cause, as the input rate's does). Wall time: it must hold under a
+// kind for diagnostics while it is recent (a diagnostics WARN ends a while after its
+// cause, as the input rate's does). Wall time: it must hold under a
 // paused or looping /clock. Thread-safe.
 #pragma once
 
 #include <ros/time.h>
 
+#include <algorithm>
 #include <map>
 #include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mono_plane_detection {
 
@@ -27,21 +30,20 @@ class RecentEvents {
     return true;
   }
 
-  // Whether an event of this kind was noted within window_s.
-  bool happened(const std::string& kind, double window_s) const {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const auto it = events_.find(kind);
-    return it != events_.end() && (ros::WallTime::now() - it->second.last).toSec() <= window_s;
-  }
-
-  // The last text of any kind noted within window_s, "" when none.
-  std::string recent(double window_s) const {
+  // Every kind noted within window_s with its last text, newest first: diagnostics show
+  // each as a key of its own, so one never hides another.
+  std::vector<std::pair<std::string, std::string>> recent(double window_s) const {
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::WallTime now = ros::WallTime::now();
-    const Event* newest = nullptr;
-    for (const auto& [kind, e] : events_)
-      if ((now - e.last).toSec() <= window_s && (!newest || e.last > newest->last)) newest = &e;
-    return newest ? newest->text : std::string();
+    std::vector<std::pair<ros::WallTime, const std::pair<const std::string, Event>*>> found;
+    for (const auto& entry : events_)
+      if ((now - entry.second.last).toSec() <= window_s)
+        found.push_back({entry.second.last, &entry});
+    std::sort(found.begin(), found.end(),
+              [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<std::pair<std::string, std::string>> out;
+    for (const auto& f : found) out.emplace_back(f.second->first, f.second->second.text);
+    return out;
   }
 
  private:

@@ -76,6 +76,11 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   return error;
 }
 
+std::string TrackerFrontEnd::infoMismatch() const {
+  if (info_size_.empty() || last_size_.empty()) return {};
+  return infoSizeMismatch(info_size_, last_size_);
+}
+
 std::string TrackerFrontEnd::targetReason() const {
   if (target_startup_.found()) return {};
   return target_startup_.lastDetection().reason;
@@ -209,6 +214,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
                                              seconds(last_stamp_ns_) +
                                              "): time went backwards (bag loop?), tracking "
                                              "starts over"});
+    ++counts_.backwards;
     startOver(stamp_ns, true);
   } else if (last_stamp_ns_ != 0) {
     const uint64_t gap_ns = stamp_ns - last_stamp_ns_;
@@ -231,16 +237,12 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   last_stamp_ns_ = stamp_ns;
   heard_ns_ = std::max(heard_ns_, stamp_ns);
   if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
-  if (!info_size_.empty() && info_size_ != image.size()) {
-    std::ostringstream why;
-    why << "camera_info is for " << info_size_.width << "x" << info_size_.height
-        << " images but the image is " << image.cols << "x" << image.rows;
-    out.warnings.push_back({"info size", why.str()});
-  }
+  if (!info_size_.empty()) out.info_mismatch = infoSizeMismatch(info_size_, image.size());
+  if (!out.info_mismatch.empty()) ++counts_.info_size_mismatch;
   tracker_.process(image);
   // A camera_info for another image size is not this image's camera: its lens would bend
   // the sheet's sides and its focal length misjudge its shape (searched as a photo instead).
-  const bool info_fits = info_size_.empty() || info_size_ == image.size();
+  const bool info_fits = out.info_mismatch.empty();
   if (params_.detect_target) {
     target_startup_.setLens(info_fits ? lens_K_ : cv::Matx33d::eye(),
                             info_fits ? lens_D_ : cv::Mat(), info_fits && lens_fisheye_);

@@ -33,6 +33,8 @@ struct TrackerOutput {
   std::string dropped;            // why it was dropped (an ERROR or WARN)
   bool dropped_is_error = false;  // bad input, not a repeat
   std::vector<LogEvent> warnings;
+  // The camera_info is for another image size (infoSizeMismatch): not used for this image.
+  std::string info_mismatch;
   std::vector<std::string> infos;
   GreyImage grey;  // the image as tracked (for the debug drawing)
 };
@@ -41,6 +43,8 @@ struct TrackerCounts {
   long dropped = 0;          // images refused (bad, too small, repeated stamp)
   long missing = 0;          // images missing from the stream (stamp gaps)
   long camera_switches = 0;  // frame_id or size changed from one image to the next
+  long backwards = 0;        // stamps went back (a bag loop): tracking started over
+  long info_size_mismatch = 0;  // images the camera_info was not used for (another size)
   long lost = 0;             // points lost, total
   long searches = 0;         // corner searches, total
   int tracked_now = 0;
@@ -60,6 +64,9 @@ class TrackerFrontEnd {
 
   const TrackerCounts& counts() const { return counts_; }
   bool hasCameraInfo() const { return !info_size_.empty(); }
+  // Now: the usable camera_info is for another size than the last image's ("" when it
+  // fits or either is missing); a matching camera_info or image clears it at once.
+  std::string infoMismatch() const;
   bool targetFound() const { return target_startup_.found(); }
   const TargetStartup& targetStartup() const { return target_startup_; }
   // Why the last image gave no target (empty once found or before any image).

@@ -55,7 +55,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     front_ = TrackerFrontEnd(params);
     // image_proc's rectified stream (image_rect*): P without distortion, as the plane
     // nodelet reads it; else the raw image's K and D (the target is searched undistorted).
-    front_.setRectified(isRectifiedTopic(nh.resolveName("image")));
+    image_topic_ = nh.resolveName("image");
+    front_.setRectified(isRectifiedTopic(image_topic_));
 
     diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose, guard_,
                        params.expected_min_rate_hz, params.expected_max_rate_hz);
@@ -89,6 +90,8 @@ class TrackerNodelet : public nodelet::Nodelet {
                                 ros::VoidPtr(), image_transport::TransportHints(front_.params().image_transport));
     info_sub_ = getNodeHandle().subscribe<sensor_msgs::CameraInfo>(
         "camera_info", 1, guard_.message("camera_info", this, &TrackerNodelet::infoCallback));
+    std::lock_guard<std::mutex> state_lock(state_mutex_);
+    subscribed_at_ = ros::WallTime::now();
   }
 
   // Optional: tracking works in pixels without it. Kept for its size, checked so that
@@ -132,6 +135,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       info_sub_.shutdown();
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       front_.reset();
+      subscribed_at_ = ros::WallTime();
     }
   }
 
@@ -150,8 +154,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     {
       std::lock_guard<std::mutex> lock(state_mutex_);
       if (first_image_.isZero()) first_image_ = started;
+      last_image_ = started;
       out = front_.process(msg);
       for (const LogEvent& event : out.warnings) warn(event);
+      // Not this image's camera (the front end does not use it): an ERROR, on wall time.
+      if (!out.info_mismatch.empty() && logged_.note("info size", out.info_mismatch, 10.0))
+        NODELET_ERROR("%s", out.info_mismatch.c_str());
       // Before target_timeout_s: why the target is not seen yet, now and then (after it, a
       // WARN says so every 5 s).
       if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
@@ -195,27 +203,45 @@ class TrackerNodelet : public nodelet::Nodelet {
   }
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    using diagnostic_msgs::DiagnosticStatus;
     std::lock_guard<std::mutex> lock(state_mutex_);
     const TrackerCounts& c = front_.counts();
     const long exceptions = guard_.count();
     const bool no_target = front_.targetOverdue();
+    const ros::WallTime now = ros::WallTime::now();
     // Images for a while and no usable camera_info: tracking goes on in pixels, but the
     // plane nodelet needs it for metres and the target check for the sheet's aspect.
     const bool no_info = !front_.hasCameraInfo() && !first_image_.isZero() &&
-                         (ros::WallTime::now() - first_image_).toSec() > kCameraInfoGraceS;
-    // Drops and camera switches count for the level while recent: the totals stay below.
-    const std::string recent = problems_.recent(kRecentS);
-    const bool warn = !recent.empty() || exceptions > 0 || no_target || no_info;
+                         (now - first_image_).toSec() > kCameraInfoGraceS;
+    // The present state first, then what happened lately (drops and camera switches count
+    // for the level while recent: the totals stay below).
+    StatusProblems problems;
     if (!subscribe_error_.empty())
-      status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, subscribe_error_);
-    else
-    status.summary(warn ? diagnostic_msgs::DiagnosticStatus::WARN
-                        : diagnostic_msgs::DiagnosticStatus::OK,
-                   exceptions > 0         ? "exceptions caught"
-                   : !recent.empty()      ? recent
-                   : no_info               ? std::string("images but no usable camera_info")
-                   : no_target            ? "no start-up target: " + front_.targetReason()
-                                           : std::string("tracking"));
+      problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
+    if (const std::string mismatch = front_.infoMismatch(); !mismatch.empty())
+      problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
+    if (!subscribed_at_.isZero()) {
+      // Subscribed (not idle) and no image yet or lately: nothing is tracked.
+      const ros::WallTime since = std::max(subscribed_at_, last_image_);
+      const double silent_s = (now - since).toSec();
+      std::ostringstream why;
+      why << std::fixed << std::setprecision(0) << "no images on " << image_topic_;
+      if (last_image_ < subscribed_at_)
+        why << " yet (subscribed " << silent_s << " s ago)";
+      else
+        why << " for " << silent_s << " s";
+      if (last_image_ < subscribed_at_ || silent_s > kNoImagesS)
+        problems.add(DiagnosticStatus::WARN, "images", why.str());
+    }
+    if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
+    if (no_info)
+      problems.add(DiagnosticStatus::WARN, "camera_info", "images but no usable camera_info");
+    if (no_target)
+      problems.add(DiagnosticStatus::WARN, "start-up target",
+                   "no start-up target: " + front_.targetReason());
+    for (const auto& [kind, text] : problems_.recent(kRecentS))
+      problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
+    problems.report(status, "tracking");
     status.add("points tracked", c.tracked_now);
     status.add("points lost (total)", c.lost);
     status.add("searches (total)", c.searches);
@@ -224,8 +250,13 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("camera switches (total)", c.camera_switches);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera_info", front_.hasCameraInfo() ? "ok" : "none or unusable");
-    status.add("resets (total)", resets_);
+    status.add("camera_info", !front_.hasCameraInfo()          ? "none or unusable"
+                              : !front_.infoMismatch().empty() ? "for another image size: not used"
+                                                               : "ok");
+    status.add("images with camera_info of another size (total)", c.info_size_mismatch);
+    // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).
+    status.add("resets (total)", resets_ + c.backwards);
+    status.add("resets: time went backwards (total)", c.backwards);
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
@@ -258,6 +289,10 @@ class TrackerNodelet : public nodelet::Nodelet {
   image_transport::Publisher debug_pub_;
   ros::ServiceServer reset_srv_;
   ros::WallTime first_image_;  // wall: diagnostics must hold under sim time
+  ros::WallTime last_image_;
+  ros::WallTime subscribed_at_;              // zero while not subscribed (lazy, nobody listens)
+  std::string image_topic_;                  // resolved
+  static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
   static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images

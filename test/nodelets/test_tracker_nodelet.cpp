@@ -142,9 +142,21 @@ TEST_F(TrackerNodeletTest, BadImagesAreDroppedAndTrackingGoesOn) {
   auto good = send(makeImage(view({0, 0}), "mono8", stamp_ += 0.1));
   ASSERT_TRUE(good);
 
-  // Unsupported encoding: dropped, nothing published.
+  // Unsupported encoding: dropped, nothing published. A depth image (16UC1) is named as
+  // what it is in plain words (it was cv_bridge's "is not a color format ... does not make
+  // sense"), in diagnostics as a problem of its own.
   cv::Mat floats(480, 640, CV_32FC1, cv::Scalar(0.5));
   EXPECT_FALSE(send(makeImage(floats, "32FC1", stamp_ += 0.1), 1.0));
+  cv::Mat depth(480, 640, CV_16UC1, cv::Scalar(1200));
+  EXPECT_FALSE(send(makeImage(depth, "16UC1", stamp_ += 0.1), 1.0));
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const std::string said = diagnostics.value("problem: last 10 s, unsupported encoding '16UC1'");
+  EXPECT_NE(said.find("depth or other single-value images (16UC1) are not supported; use the "
+                      "camera's grey or colour image (mono8/mono16 or bgr8)"),
+            std::string::npos)
+      << said;
+  EXPECT_FALSE(diagnostics.value("problem: last 10 s, unsupported encoding '32FC1'").empty());
   auto weird = makeImage(view({0, 0}), "mono8", stamp_ += 0.1);
   weird->encoding = "no_such_encoding";
   EXPECT_FALSE(send(weird, 1.0));
@@ -252,9 +264,19 @@ TEST_F(TrackerNodeletTest, TimeGoingBackwardsStartsOver) {
   ASSERT_TRUE(looped);
   for (auto f : looped->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);
   for (auto p : looped->prev_index) EXPECT_EQ(p, -1);
+  // Counted with the resets (it counted ~reset calls only).
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_GE(diagnostics.number("resets: time went backwards (total)"), 1);
+  EXPECT_GE(diagnostics.number("resets (total)"),
+            diagnostics.number("resets: time went backwards (total)"));
 }
 
+// A camera_info for another image size (1280x720, no binning) is not the images' camera:
+// not used, an ERROR in diagnostics that names both sizes and what to do, counted; one
+// for the images' size is used from the next image on (it said "camera_info: ok").
 TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
   ros::Publisher info_pub = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
   sensor_msgs::CameraInfo zero;  // all-zero intrinsics
   zero.width = 640;
@@ -277,6 +299,30 @@ TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
   tracks = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 0.1));
   ASSERT_TRUE(tracks);
   EXPECT_GE(tracks->id.size(), 45u);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("camera_info is for 1280x720 images but the images are "
+                                       "640x480: not used"),
+            std::string::npos)
+      << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("binning_x/y or ROI"), std::string::npos);
+  EXPECT_EQ(diagnostics.value("camera_info"), "for another image size: not used");
+  EXPECT_GE(diagnostics.number("images with camera_info of another size (total)"), 1);
+  EXPECT_FALSE(diagnostics.value("problem: camera_info").empty());
+
+  sensor_msgs::CameraInfo right = other_size;  // the images' own size: used at once
+  right.width = 640;
+  right.height = 480;
+  right.K = {525, 0, 320, 0, 525, 240, 0, 0, 1};
+  info_pub.publish(right);
+  scaledWait(0.3).sleep();
+  ASSERT_TRUE(send(makeImage(view({1.0, 0}), "mono8", stamp_ += 0.1)));
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_EQ(diagnostics.value("camera_info"), "ok");
+  EXPECT_EQ(diagnostics.value("problem: camera_info"), "");
+  info_pub.publish(zero);  // latched for the later tests: as before, no usable intrinsics
+  scaledWait(0.3).sleep();
 }
 
 TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
@@ -503,7 +549,9 @@ TEST_F(TrackerNodeletTest, ResetStartsEveryTrackOver) {
     EXPECT_GT(after->id[i], newest);
   }
   ASSERT_TRUE(diagnostics.waitFresh());
-  EXPECT_EQ(diagnostics.number("resets (total)"), 1);
+  EXPECT_EQ(diagnostics.number("resets (total)") -
+                diagnostics.number("resets: time went backwards (total)"),
+            1);
 }
 
 // Issue 14: images and no usable camera_info for more than 5 s: WARN, with the reason.
@@ -563,6 +611,45 @@ TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
   }
   nodelet::NodeletUnload unload;
   unload.request.name = "/tracker_lazy_no_transport";
+  EXPECT_TRUE(ros::service::call("/manager/unload_nodelet", unload) && unload.response.success);
+}
+
+// Subscribed and no image (before the first one, and once the stream stopped): WARN "no
+// images on <topic>", not OK "tracking".
+TEST_F(TrackerNodeletTest, NoImagesIsAWarningNotTracking) {
+  ros::param::set("/tracker_silent/detect_target", false);
+  nodelet::NodeletLoad load;
+  load.request.name = "/tracker_silent";
+  load.request.type = "mono_plane_detection/TrackerNodelet";
+  load.request.remap_source_args = {"tracks", "image", "camera_info"};
+  load.request.remap_target_args = {"tracks_silent", "image_silent", "camera_info_silent"};
+  ASSERT_TRUE(ros::service::call("/manager/load_nodelet", load) && load.response.success);
+  ros::Publisher images = nh_.advertise<sensor_msgs::Image>("image_silent", 10);
+  std::map<uint64_t, TracksConstPtr> got;
+  ros::Subscriber tracks = nh_.subscribe<Tracks>(
+      "tracks_silent", 10, [&](const TracksConstPtr& m) { got[m->header.stamp.toNSec()] = m; });
+  ASSERT_TRUE(spinUntil([&] { return images.getNumSubscribers() > 0; }, 20.0));
+  DiagnosticsProbe diagnostics(nh_, "tracker_silent: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN) << diagnostics.message();
+  EXPECT_EQ(diagnostics.message().rfind("no images on /image_silent yet", 0), 0u)
+      << diagnostics.message();
+  double stamp = 10;
+  for (int k = 0; k < 10; ++k) {
+    images.publish(makeImage(view({0.5 * k, 0}), "mono8", stamp += 0.1));
+    spinUntil([] { return false; }, 0.1);
+  }
+  EXPECT_GT(got.size(), 5u);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.message(), "tracking");
+  spinUntil([] { return false; }, 6.5);  // the stream stopped
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(diagnostics.message().rfind("no images on /image_silent for ", 0), 0u)
+      << diagnostics.message();
+  nodelet::NodeletUnload unload;
+  unload.request.name = "/tracker_silent";
   EXPECT_TRUE(ros::service::call("/manager/unload_nodelet", unload) && unload.response.success);
 }
 
