@@ -82,9 +82,8 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
 };
 
 // Every problem a status has now, each under a key of its own ("problem: <key>": none
-// hides another); the
-// summary is the most severe, the first added of equal ones (callers add the present
-// state before what happened lately).
+// hides another); the summary is the most severe, the first added of equal ones (callers
+// add the present state before what happened lately).
 class StatusProblems {
  public:
   void add(unsigned char level, const std::string& key, const std::string& text) {

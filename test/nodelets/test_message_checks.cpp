@@ -11,6 +11,7 @@
 #include <opencv2/calib3d.hpp>
 
 #include "../../src/nodelets/camera_info_check.h"
+#include "../../src/nodelets/nodelet_diagnostics.h"
 #include "../../src/nodelets/plane_messages.h"
 #include "../../src/nodelets/recent_events.h"
 #include "../../src/nodelets/tracker_front_end.h"
@@ -221,6 +222,31 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
 
 // What went wrong lately: one log per kind and period, and every kind still recent with
 // its last text, newest first (diagnostics show each: one never hides another).
+// A user at the robot sees every problem, each under its own key, the worst as the summary.
+TEST(StatusProblems, EveryProblemHasItsKeyAndTheWorstIsTheSummary) {
+  auto value = [](const diagnostic_updater::DiagnosticStatusWrapper& s, const std::string& key) {
+    for (const auto& kv : s.values)
+      if (kv.key == key) return kv.value;
+    return std::string("(none)");
+  };
+  StatusProblems problems;
+  problems.add(diagnostic_msgs::DiagnosticStatus::WARN, "odometry", "odometry stopped");
+  problems.add(diagnostic_msgs::DiagnosticStatus::ERROR, "camera_info", "camera_info size");
+  problems.add(diagnostic_msgs::DiagnosticStatus::ERROR, "tracks", "bad tracks");
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  problems.report(status, "mapping");
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, "camera_info size");  // the first of the worst
+  EXPECT_EQ(value(status, "problems now"), "3");
+  EXPECT_EQ(value(status, "problem: odometry"), "WARN: odometry stopped");
+  EXPECT_EQ(value(status, "problem: tracks"), "ERROR: bad tracks");
+  diagnostic_updater::DiagnosticStatusWrapper fine;
+  StatusProblems().report(fine, "mapping");
+  EXPECT_EQ(fine.level, diagnostic_msgs::DiagnosticStatus::OK);
+  EXPECT_EQ(fine.message, "mapping");
+  EXPECT_EQ(value(fine, "problems now"), "0");
+}
+
 TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
   using Recent = std::vector<std::pair<std::string, std::string>>;
   RecentEvents events;
