@@ -806,7 +806,11 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
-    status.add("camera model", !pipeline_->hasCamera()      ? "none"
+    // The calibration held (used from the next tracks of its image size on).
+    const bool info_fits =
+        last_tracks_size_.empty() || infoSizeMismatch(camera_.size, last_tracks_size_).empty();
+    status.add("camera model", !has_info_                   ? "none"
+                               : !info_fits                 ? "not used: camera_info for another image size"
                                : camera_.rectified          ? "rectified (P)"
                                : !camera_.fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
                                                             : "raw (K, D)");
