@@ -122,7 +122,8 @@ class NodeletDiagnostics {
              void (Owner::*diagnose)(diagnostic_updater::DiagnosticStatusWrapper&),
              CallbackGuard& guard, double min_rate_hz, double max_rate_hz) {
     updater_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh, name);
-    updater_->setHardwareID("camera");
+    // The camera's namespace: two cameras' nodelets are told apart by aggregators.
+    updater_->setHardwareID(nh.getNamespace());
     rate_ = std::make_unique<WallRateStatus>(min_rate_hz, max_rate_hz);
     updater_->add(*rate_);
     updater_->add(task, owner, diagnose);

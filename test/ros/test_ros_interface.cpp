@@ -195,6 +195,11 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   ASSERT_TRUE(status.waitFresh());
   EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
   EXPECT_EQ(status.level(), diagnostic_msgs::DiagnosticStatus::OK) << status.message();
+  // Each camera's nodelets under their camera's name (an aggregator tells them apart).
+  EXPECT_EQ(status.hardwareId(), "/front");
+  DiagnosticsProbe rear_status(nh, "rear/plane_detector: planes");
+  ASSERT_TRUE(rear_status.waitFresh());
+  EXPECT_EQ(rear_status.hardwareId(), "/rear");
   const double hz = std::stod(rate.value("actual frequency (Hz)"));
   // The replay's 30 Hz as the node sees it, on wall time (a loaded CI machine answered
   // 9.4 Hz): far from the 0.03 Hz a rate read on simulated time gave.

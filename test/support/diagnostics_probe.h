@@ -33,6 +33,7 @@ class DiagnosticsProbe {
   }
   int level() const { return status_.level; }
   const std::string& message() const { return status_.message; }
+  const std::string& hardwareId() const { return status_.hardware_id; }
 
  private:
   void onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& msg) {
