@@ -768,10 +768,10 @@ class PlaneNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::ERROR, "start-up target",
                    "start-up target: " + target_mismatch_);
     // (Now: a camera_info or tracks of the right size clear it at once.)
-    if (has_info_ && !last_tracks_size_.empty())
-      if (const std::string mismatch = infoSizeMismatch(camera_.size, last_tracks_size_);
-          !mismatch.empty())
-        problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
+    const std::string info_mismatch = has_info_ && !last_tracks_size_.empty()
+                                          ? infoSizeMismatch(camera_.size, last_tracks_size_)
+                                          : "";
+    if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
     if (frames_ > 0 && !has_info_)
       problems.add(DiagnosticStatus::WARN, "camera_info",
                    "tracks arrive but no usable camera_info");
@@ -807,10 +807,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
     // The calibration held (used from the next tracks of its image size on).
-    const bool info_fits =
-        last_tracks_size_.empty() || infoSizeMismatch(camera_.size, last_tracks_size_).empty();
     status.add("camera model", !has_info_                   ? "none"
-                               : !info_fits                 ? "not used: camera_info for another image size"
+                               : !info_mismatch.empty()     ? "not used: camera_info for another image size"
                                : camera_.rectified          ? "rectified (P)"
                                : !camera_.fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
                                                             : "raw (K, D)");

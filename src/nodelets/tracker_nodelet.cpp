@@ -218,20 +218,20 @@ class TrackerNodelet : public nodelet::Nodelet {
     StatusProblems problems;
     if (!subscribe_error_.empty())
       problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
-    if (const std::string mismatch = front_.infoMismatch(); !mismatch.empty())
-      problems.add(DiagnosticStatus::ERROR, "camera_info", mismatch);
+    const std::string info_mismatch = front_.infoMismatch();
+    if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
     if (!subscribed_at_.isZero()) {
       // Subscribed (not idle) and no image yet or lately: nothing is tracked.
       const ros::WallTime since = std::max(subscribed_at_, last_image_);
       const double silent_s = (now - since).toSec();
-      std::ostringstream why;
-      why << std::fixed << std::setprecision(0) << "no images on " << image_topic_;
-      if (last_image_ < subscribed_at_)
-        why << " yet (subscribed " << silent_s << " s ago)";
-      else
-        why << " for " << silent_s << " s";
-      if (last_image_ < subscribed_at_ || silent_s > kNoImagesS)
+      const bool none_yet = last_image_ < subscribed_at_;
+      if (none_yet || silent_s > kNoImagesS) {
+        std::ostringstream why;
+        why << std::fixed << std::setprecision(0) << "no images on " << image_topic_
+            << (none_yet ? " yet (subscribed " : " for ") << silent_s
+            << (none_yet ? " s ago)" : " s");
         problems.add(DiagnosticStatus::WARN, "images", why.str());
+      }
     }
     if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
     if (no_info)
@@ -250,8 +250,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("camera switches (total)", c.camera_switches);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera_info", !front_.hasCameraInfo()          ? "none or unusable"
-                              : !front_.infoMismatch().empty() ? "for another image size: not used"
+    status.add("camera_info", !front_.hasCameraInfo()   ? "none or unusable"
+                              : !info_mismatch.empty()  ? "for another image size: not used"
                                                                : "ok");
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
     // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).
