@@ -125,15 +125,35 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
   return fromCameraInfo(info, out.K, out.D);
 }
 
-std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size) {
+std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size,
+                             bool earlier_kept) {
   if (info_size == image_size) return {};
   std::ostringstream why;
   why << "camera_info is for " << info_size.width << "x" << info_size.height
       << " images but the images are " << image_size.width << "x" << image_size.height
-      << ": not used for them (planes stay in image space); publish the camera's binning_x/y "
-         "or ROI in camera_info, or a calibration made at "
+      << ": not used for them ("
+      << (earlier_kept ? "the last camera_info of their size still is"
+                       : "planes stay in image space")
+      << "); publish the camera's binning_x/y or ROI in camera_info, or a calibration made at "
       << image_size.width << "x" << image_size.height;
   return why.str();
+}
+
+const CameraIntrinsics* CalibrationHolder::heldFor(const cv::Size& size) const {
+  if (latest_ && latest_->size == size) return &*latest_;
+  return held_ && held_->size == size ? &*held_ : nullptr;
+}
+
+std::string CalibrationHolder::mismatch(const cv::Size& size) const {
+  if (!latest_ || size.empty()) return {};
+  return infoSizeMismatch(latest_->size, size, held_ && held_->size == size);
+}
+
+const CameraIntrinsics* CalibrationHolder::forImages(const cv::Size& size,
+                                                     std::string& mismatch_text) {
+  if (latest_ && latest_->size == size) held_ = latest_;
+  mismatch_text = mismatch(size);
+  return heldFor(size);
 }
 
 bool isRectifiedTopic(const std::string& topic) {

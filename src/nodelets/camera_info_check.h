@@ -10,6 +10,7 @@
 #include <sensor_msgs/CameraInfo.h>
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "mono_plane_detection/tracking/track_frame.h"
@@ -41,8 +42,30 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
 
 // Empty when a camera_info describing images of `info_size` (binning and ROI applied:
 // CameraIntrinsics::size) is these images' camera, else the ERROR both nodelets give: it
-// names both sizes and what to do. Such a camera_info is not used for those images.
-std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size);
+// names both sizes and what to do. Such a camera_info is not used for those images;
+// `earlier_kept`: an earlier camera_info of their size still is (CalibrationHolder).
+std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size,
+                             bool earlier_kept = false);
+
+// Which calibration describes the images: the last usable camera_info when it is of their
+// size, else the last one that was. A stray camera_info of another size (a second driver
+// on the topic, a calibration reloaded at another resolution) is then an ERROR in the
+// diagnostics but does not take the camera, and with it the map, away from the images.
+class CalibrationHolder {
+ public:
+  void offer(const CameraIntrinsics& camera) { latest_ = camera; }
+  // For images of `size`: the calibration to use (null: none, image-space planes), and
+  // in `mismatch` the ERROR when the last camera_info is of another size.
+  const CameraIntrinsics* forImages(const cv::Size& size, std::string& mismatch);
+  // The same without taking the last camera_info (diagnostics).
+  const CameraIntrinsics* heldFor(const cv::Size& size) const;
+  std::string mismatch(const cv::Size& size) const;
+  const std::optional<CameraIntrinsics>& latest() const { return latest_; }
+
+ private:
+  std::optional<CameraIntrinsics> latest_;  // the last usable camera_info
+  std::optional<CameraIntrinsics> held_;    // the last one of the images' size
+};
 
 // A rectified stream by its topic's name: image_proc calls it image_rect (or image_rect_color).
 bool isRectifiedTopic(const std::string& resolved_image_topic);

@@ -242,8 +242,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN("camera_info rejected: %s; image-space planes only", error.c_str());
       return;
     }
-    camera_ = camera;  // (its size with binning and ROI applied)
-    has_info_ = true;
+    calibration_.offer(camera);  // (its size with binning and ROI applied)
   }
 
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -631,21 +630,22 @@ class PlaneNodelet : public nodelet::Nodelet {
         if (logNow("target mismatch", 10.0)) NODELET_ERROR("%s", target_mismatch_.c_str());
         frame.target_corner.assign(frame.target_corner.size(), false);
       }
-      // The camera_info describes tracks of its image size only (binning and ROI applied):
-      // for others the pipeline has no camera (image-space planes, no target pose from it),
-      // and the next tracks of its size use it at once.
-      const std::string info_mismatch = has_info_ ? infoSizeMismatch(camera_.size, frame.size) : "";
+      // A camera_info describes tracks of its image size only (binning and ROI applied):
+      // the last one of their size is used; with none the pipeline has no camera
+      // (image-space planes, no target pose from it) until one comes.
+      std::string info_mismatch;
+      const CameraIntrinsics* camera = calibration_.forImages(frame.size, info_mismatch);
       if (!info_mismatch.empty()) {
         ++info_size_mismatch_;
         if (logNow("info size", 10.0)) NODELET_ERROR("%s", info_mismatch.c_str());
-        if (pipeline_->hasCamera()) {  // (the map of that camera does not apply)
-          pipeline_ = std::make_unique<PlanePipeline>(params_);
-          mapStartedOver();
-        }
-      } else if (has_info_) {
-        pipeline_->setCamera(camera_.K, camera_.D);  // (checked on arrival; same: no change)
-        undistortFisheye(frame, camera_);            // equidistant: pinhole pixels of the same K
-      } else if (logNow("no camera_info", 10.0)) {
+      }
+      if (camera) {
+        pipeline_->setCamera(camera->K, camera->D);  // (checked on arrival; same: no change)
+        undistortFisheye(frame, *camera);            // equidistant: pinhole pixels of the same K
+      } else if (pipeline_->hasCamera()) {  // (the map of that camera does not apply)
+        pipeline_ = std::make_unique<PlanePipeline>(params_);
+        mapStartedOver();
+      } else if (!calibration_.latest() && logNow("no camera_info", 10.0)) {
         NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
                      info_sub_.getTopic().c_str());
       }
@@ -768,11 +768,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::ERROR, "start-up target",
                    "start-up target: " + target_mismatch_);
     // (Now: a camera_info or tracks of the right size clear it at once.)
-    const std::string info_mismatch = has_info_ && !last_tracks_size_.empty()
-                                          ? infoSizeMismatch(camera_.size, last_tracks_size_)
-                                          : "";
+    const std::string info_mismatch = calibration_.mismatch(last_tracks_size_);
     if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
-    if (frames_ > 0 && !has_info_)
+    if (frames_ > 0 && !calibration_.latest())
       problems.add(DiagnosticStatus::WARN, "camera_info",
                    "tracks arrive but no usable camera_info");
     if (state_ == PipelineState::kLost)
@@ -806,12 +804,15 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
-    // The calibration held (used from the next tracks of its image size on).
-    status.add("camera model", !has_info_                   ? "none"
-                               : !info_mismatch.empty()     ? "not used: camera_info for another image size"
-                               : camera_.rectified          ? "rectified (P)"
-                               : !camera_.fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
-                                                            : "raw (K, D)");
+    // The calibration of the last tracks' size (before any: the last camera_info).
+    const CameraIntrinsics* held = last_tracks_size_.empty()
+                                       ? (calibration_.latest() ? &*calibration_.latest() : nullptr)
+                                       : calibration_.heldFor(last_tracks_size_);
+    status.add("camera model", !calibration_.latest()     ? "none"
+                               : !held                    ? "not used: camera_info for another image size"
+                               : held->rectified          ? "rectified (P)"
+                               : !held->fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
+                                                          : "raw (K, D)");
     status.add("tf", !tf_conflict_.empty() ? "refused: " + tf_conflict_
                      : !publish_tf_        ? std::string("off")
                      : tf_edge_.empty()    ? std::string("nothing published yet")
@@ -869,8 +870,7 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;
-  CameraIntrinsics camera_;
-  bool has_info_ = false;               // camera_ holds a usable camera_info
+  CalibrationHolder calibration_;       // the usable camera_infos
   long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
   long backwards_resets_ = 0;           // map resets because time went backwards
   double waited_before_s_ = 0;          // in earlier stretches of the stream (tracks stamps), s

@@ -65,20 +65,12 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   // rectified one's P (image_geometry's camera model).
   CameraIntrinsics lens;
   if (error.empty()) error = intrinsicsFromCameraInfo(info, rectified_, lens);
-  const bool usable = error.empty();
-  info_size_ = usable ? lens.size : cv::Size();  // (binning and ROI applied)
-  const bool fisheye = usable && !lens.fisheye_D.empty();
-  focal_px_ = usable ? lens.K(0, 0) : 0;
-  principal_px_ = usable ? cv::Point2d(lens.K(0, 2), lens.K(1, 2)) : cv::Point2d(-1, -1);
-  lens_K_ = usable ? lens.K : cv::Matx33d::eye();
-  lens_D_ = usable ? (fisheye ? lens.fisheye_D : lens.D) : cv::Mat();
-  lens_fisheye_ = fisheye;
+  if (error.empty()) calibration_.offer(lens);  // (binning and ROI applied)
   return error;
 }
 
 std::string TrackerFrontEnd::infoMismatch() const {
-  if (info_size_.empty() || last_size_.empty()) return {};
-  return infoSizeMismatch(info_size_, last_size_);
+  return calibration_.mismatch(last_size_);
 }
 
 std::string TrackerFrontEnd::targetReason() const {
@@ -237,15 +229,21 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   last_stamp_ns_ = stamp_ns;
   heard_ns_ = std::max(heard_ns_, stamp_ns);
   if (!msg->header.frame_id.empty()) last_frame_id_ = msg->header.frame_id;
-  if (!info_size_.empty()) out.info_mismatch = infoSizeMismatch(info_size_, image.size());
-  if (!out.info_mismatch.empty()) ++counts_.info_size_mismatch;
-  tracker_.process(image);
   // A camera_info for another image size is not this image's camera: its lens would bend
   // the sheet's sides and its focal length misjudge its shape (searched as a photo instead).
-  const bool info_fits = out.info_mismatch.empty();
+  // The last one of this size is used, else none.
+  const CameraIntrinsics* lens = calibration_.forImages(image.size(), out.info_mismatch);
+  if (!out.info_mismatch.empty()) ++counts_.info_size_mismatch;
+  tracker_.process(image);
+  // The target is searched with the lens undone (straight sides) and its aspect judged
+  // with the focal length of the pixels it is searched in.
+  const double focal_px = lens ? lens->K(0, 0) : 0;
+  const cv::Point2d principal_px = lens ? cv::Point2d(lens->K(0, 2), lens->K(1, 2))
+                                        : cv::Point2d(-1, -1);
   if (params_.detect_target) {
-    target_startup_.setLens(info_fits ? lens_K_ : cv::Matx33d::eye(),
-                            info_fits ? lens_D_ : cv::Mat(), info_fits && lens_fisheye_);
+    const bool fisheye = lens && !lens->fisheye_D.empty();
+    target_startup_.setLens(lens ? lens->K : cv::Matx33d::eye(),
+                            lens ? (fisheye ? lens->fisheye_D : lens->D) : cv::Mat(), fisheye);
   }
   // Paper II-A: until the start-up target is seen, look for it; its corners become
   // tracked points flagged as target corners.
@@ -255,8 +253,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     if (target_wait_start_ns_ == 0) target_wait_start_ns_ = stamp_ns;
     target_wait_last_ns_ = stamp_ns;
     if (const auto target =
-            target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,
-                                    info_fits ? principal_px_ : cv::Point2d(-1, -1))) {
+            target_startup_.process(image, tracker_, focal_px, principal_px)) {
       std::ostringstream what;
       what << "start-up target (" << params_.target.target_type << ") confirmed in "
            << params_.target.confirm_frames << " consecutive images";
@@ -273,8 +270,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     }
   } else if (params_.detect_target) {
     // Confirmed: found again around its tracked corners, which then do not drift.
-    target_startup_.process(image, tracker_, info_fits ? focal_px_ : 0,
-                            info_fits ? principal_px_ : cv::Point2d(-1, -1));
+    target_startup_.process(image, tracker_, focal_px, principal_px);
   }
   const TrackerFrameStats& stats = tracker_.lastStats();
   counts_.searches += stats.searched ? 1 : 0;

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "camera_info_check.h"
 #include "image_input.h"
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/params/param_table.h"
@@ -63,7 +64,9 @@ class TrackerFrontEnd {
   void setRectified(bool rectified) { rectified_ = rectified; }
 
   const TrackerCounts& counts() const { return counts_; }
-  bool hasCameraInfo() const { return !info_size_.empty(); }
+  bool hasCameraInfo() const { return calibration_.latest().has_value(); }
+  // A camera_info of the last image's size is used (the newest or an earlier one).
+  bool hasCalibrationForImages() const { return calibration_.heldFor(last_size_) != nullptr; }
   // Now: the usable camera_info is for another size than the last image's ("" when it
   // fits or either is missing); a matching camera_info or image clears it at once.
   std::string infoMismatch() const;
@@ -92,15 +95,10 @@ class TrackerFrontEnd {
   uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet
   cv::Size last_size_;
   std::string last_frame_id_;
-  cv::Size info_size_;
   bool rectified_ = false;
-  double focal_px_ = 0;            // from camera_info (K, or P when rectified), 0 when unknown
-  cv::Point2d principal_px_{-1, -1};  // the same, negative when unknown
-  // The lens the target is undistorted with (identity and none when unknown); given to
-  // the target start-up only for images of camera_info's size.
-  cv::Matx33d lens_K_ = cv::Matx33d::eye();
-  cv::Mat lens_D_;
-  bool lens_fisheye_ = false;
+  // The usable camera_infos (K and D, or P when rectified): the lens the target is
+  // undistorted with, given to the target start-up only for images of its size.
+  CalibrationHolder calibration_;
   uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
   uint64_t target_wait_last_ns_ = 0;
   // Waited in earlier stretches of the stream, s: a jump of the stamps (bag loop, a bad

@@ -101,8 +101,9 @@ class TrackerNodelet : public nodelet::Nodelet {
     const std::string error = front_.setCameraInfo(*info);
     if (!error.empty() && problems_.note("camera_info " + reasonKind(error),
                                          "camera_info unusable: " + error, 10.0))
-      NODELET_WARN("camera_info unusable (%s): ignored, tracking goes on in pixels",
-                   error.c_str());
+      NODELET_WARN("camera_info unusable (%s): ignored, %s", error.c_str(),
+                   front_.hasCameraInfo() ? "the last usable one stays in use"
+                                          : "tracking goes on in pixels");
   }
 
   // Lazy subscription: nobody listens, nothing is tracked. Tracking restarts fresh
@@ -250,9 +251,11 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("camera switches (total)", c.camera_switches);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera_info", !front_.hasCameraInfo()   ? "none or unusable"
-                              : !info_mismatch.empty()  ? "for another image size: not used"
-                                                               : "ok");
+    status.add("camera_info", !front_.hasCameraInfo()          ? "none or unusable"
+                              : info_mismatch.empty()            ? "ok"
+                              : front_.hasCalibrationForImages() ? "the last of the images' size "
+                                                                   "(the newest is for another size)"
+                                                                 : "for another image size: not used");
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
     // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).
     status.add("resets (total)", resets_ + c.backwards);

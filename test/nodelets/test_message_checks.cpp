@@ -205,9 +205,16 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
   info.binning_x = info.binning_y = 1;  // the sensor's full size: not these images
   ASSERT_EQ(front.setCameraInfo(info), "");
   const TrackerOutput other = front.process(image(textured({640, 480}), 100, 33000000));
-  EXPECT_EQ(other.info_mismatch, infoSizeMismatch({1280, 960}, {640, 480}));
+  // (The binned one before it still is: CalibrationHolder.)
+  EXPECT_EQ(other.info_mismatch, infoSizeMismatch({1280, 960}, {640, 480}, true));
   EXPECT_EQ(front.infoMismatch(), other.info_mismatch);  // the state, for diagnostics
   EXPECT_EQ(front.counts().info_size_mismatch, 1);
+  EXPECT_TRUE(front.hasCalibrationForImages());
+  TrackerFrontEnd fresh{TrackerNodeParams()};  // only the sensor's: none for the images
+  ASSERT_EQ(fresh.setCameraInfo(info), "");
+  EXPECT_EQ(fresh.process(image(textured({640, 480}), 100)).info_mismatch,
+            infoSizeMismatch({1280, 960}, {640, 480}));
+  EXPECT_FALSE(fresh.hasCalibrationForImages());
   info.binning_x = info.binning_y = 2;  // right again: at once, before the next image
   ASSERT_EQ(front.setCameraInfo(info), "");
   EXPECT_EQ(front.infoMismatch(), "");
@@ -217,7 +224,54 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
             std::string::npos);
   EXPECT_NE(text.find("binning_x/y or ROI"), std::string::npos);
   EXPECT_NE(text.find("a calibration made at 640x480"), std::string::npos);
+  EXPECT_NE(text.find("planes stay in image space"), std::string::npos);
+  EXPECT_NE(infoSizeMismatch({1280, 960}, {640, 480}, true)
+                .find("the last camera_info of their size still is"),
+            std::string::npos);
   EXPECT_EQ(infoSizeMismatch({640, 480}, {640, 480}), "");
+}
+
+// A stray camera_info of another size (a second driver on the topic) does not take the
+// calibration from the images: the last one of their size stays, the mismatch is named.
+TEST(CalibrationHolder, TheLastCameraInfoOfTheImagesSizeIsUsed) {
+  CameraIntrinsics vga, sensor, vga2;
+  vga.size = {640, 480};
+  vga.K = cv::Matx33d(500, 0, 320, 0, 500, 240, 0, 0, 1);
+  sensor.size = {1280, 960};
+  sensor.K = cv::Matx33d(1000, 0, 640, 0, 1000, 480, 0, 0, 1);
+  vga2 = vga;
+  vga2.K(0, 0) = vga2.K(1, 1) = 510;
+  CalibrationHolder holder;
+  std::string mismatch = "x";
+  EXPECT_EQ(holder.forImages({640, 480}, mismatch), nullptr);  // none yet
+  EXPECT_EQ(mismatch, "");
+  EXPECT_EQ(holder.mismatch({640, 480}), "");
+  holder.offer(sensor);  // only another size's: not used, named, nothing earlier kept
+  EXPECT_EQ(holder.forImages({640, 480}, mismatch), nullptr);
+  EXPECT_EQ(mismatch, infoSizeMismatch({1280, 960}, {640, 480}));
+  holder.offer(vga);
+  const CameraIntrinsics* used = holder.forImages({640, 480}, mismatch);
+  ASSERT_NE(used, nullptr);
+  EXPECT_EQ(used->K(0, 0), 500);
+  EXPECT_EQ(mismatch, "");
+  holder.offer(sensor);  // the stray one: the VGA calibration stays, the ERROR says so
+  used = holder.forImages({640, 480}, mismatch);
+  ASSERT_NE(used, nullptr);
+  EXPECT_EQ(used->K(0, 0), 500);
+  EXPECT_EQ(mismatch, infoSizeMismatch({1280, 960}, {640, 480}, true));
+  EXPECT_EQ(holder.mismatch({640, 480}), mismatch);
+  ASSERT_NE(holder.heldFor({640, 480}), nullptr);
+  EXPECT_EQ(holder.heldFor({320, 240}), nullptr);
+  // Images of the sensor's size now: its own camera_info describes them.
+  used = holder.forImages({1280, 960}, mismatch);
+  ASSERT_NE(used, nullptr);
+  EXPECT_EQ(used->K(0, 0), 1000);
+  EXPECT_EQ(mismatch, "");
+  holder.offer(vga2);  // a new calibration of the images' size replaces the old one
+  used = holder.forImages({640, 480}, mismatch);
+  ASSERT_NE(used, nullptr);
+  EXPECT_EQ(used->K(0, 0), 510);
+  EXPECT_EQ(holder.mismatch({0, 0}), "");  // no images yet: nothing to compare
 }
 
 // What went wrong lately: one log per kind and period, and every kind still recent with

@@ -697,19 +697,31 @@ TEST_F(PlaneNodeletTest, K_CameraInfoDistortionVariants) {
   ASSERT_TRUE(diagnostics.waitFresh());  // (no size warning before this one)
   EXPECT_EQ(diagnostics.message().find(other_size), std::string::npos) << diagnostics.message();
   // Without binning: another image size. Not used (it made a confirmed false ceiling of a
-  // real room): image-space planes, an ERROR naming both sizes and what to do, counted.
+  // real room); the binned one before it, of the images' size, still is (a stray
+  // camera_info does not drop the map): an ERROR naming both sizes and what to do, counted.
+  const long planes_before = diagnostics.number("planes in the map");
   sensor.binning_x = sensor.binning_y = 1;
   const long mismatched = diagnostics.number("tracks with camera_info of another size (total)");
-  last = publishAndDrive(sensor);
-  ASSERT_TRUE(last) << "no answer with the sensor's camera_info";
-  EXPECT_FALSE(last->metric);
-  EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
+  info_pub_.publish(sensor);
+  scaledWait(0.5).sleep();
+  for (int k = 15; k < 30; ++k) {  // the same stretch of images on
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += offset;
+    last = send(toTracks(f));
+    ASSERT_TRUE(last) << "no answer with the sensor's camera_info";
+  }
+  EXPECT_NE(last->status, "no camera intrinsics: image-space planes only");
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
   EXPECT_NE(diagnostics.message().find(other_size + " but the images are 640x480: not used"),
             std::string::npos)
       << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("the last camera_info of their size still is"),
+            std::string::npos)
+      << diagnostics.message();
   EXPECT_NE(diagnostics.message().find("binning_x/y or ROI"), std::string::npos);
+  EXPECT_EQ(diagnostics.value("camera model"), "raw (K, D)");
+  EXPECT_GE(diagnostics.number("planes in the map"), planes_before);
   EXPECT_EQ(diagnostics.number("tracks with camera_info of another size (total)"), mismatched + 15);
   EXPECT_EQ(diagnostics.number("camera_info messages rejected"), rejected + 4);
   // The right one again: used from the next tracks on, the ERROR gone at once.
@@ -724,23 +736,39 @@ TEST_F(PlaneNodeletTest, K_CameraInfoDistortionVariants) {
   small.width /= 2;
   small.height /= 2;
   for (int i : {0, 2, 4, 5}) small.K[i] /= 2;
+  auto sendSmall = [&](int frames) {
+    offset += 10;
+    for (int k = 0; k < frames; ++k) {
+      TrackFrame f = world_->frame(k / 30.0);
+      f.stamp += offset;
+      TracksPtr msg = toTracks(f);
+      msg->width /= 2;
+      msg->height /= 2;
+      for (auto& u : msg->u) u /= 2;
+      for (auto& v : msg->v) v /= 2;
+      last = send(msg);
+      if (!last) return;
+    }
+  };
   info_pub_.publish(small);
   scaledWait(0.5).sleep();
-  offset += 10;
-  for (int k = 0; k < 5; ++k) {
-    TrackFrame f = world_->frame(k / 30.0);
-    f.stamp += offset;
-    TracksPtr msg = toTracks(f);
-    msg->width /= 2;
-    msg->height /= 2;
-    for (auto& u : msg->u) u /= 2;
-    for (auto& v : msg->v) v /= 2;
-    last = send(msg);
-    ASSERT_TRUE(last) << k;
-  }
+  sendSmall(5);
+  ASSERT_TRUE(last);
   EXPECT_NE(last->status, "no camera intrinsics: image-space planes only");
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  // The sensor's unbinned camera_info again, and images of 640x480: no camera_info of
+  // their size is the last one or the last that fitted them: image-space planes.
+  sensor.binning_x = sensor.binning_y = 1;
+  last = publishAndDrive(sensor);
+  ASSERT_TRUE(last);
+  EXPECT_FALSE(last->metric);
+  EXPECT_EQ(last->status, "no camera intrinsics: image-space planes only");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("planes stay in image space"), std::string::npos)
+      << diagnostics.message();
+  EXPECT_EQ(diagnostics.value("camera model"), "not used: camera_info for another image size");
   info_pub_.publish(cameraInfo(world_->camera));  // latched: leave a good one
 }
 

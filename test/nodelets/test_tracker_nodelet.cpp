@@ -321,8 +321,15 @@ TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
   EXPECT_NE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
   EXPECT_EQ(diagnostics.value("camera_info"), "ok");
   EXPECT_EQ(diagnostics.value("problem: camera_info"), "");
-  info_pub.publish(zero);  // latched for the later tests: as before, no usable intrinsics
+  // An unusable one after it is ignored: the last usable camera_info stays in use (it is
+  // latched for the later tests).
+  info_pub.publish(zero);
   scaledWait(0.3).sleep();
+  ASSERT_TRUE(send(makeImage(view({1.5, 0}), "mono8", stamp_ += 0.1)));
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("camera_info"), "ok");
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN) << diagnostics.message();
+  EXPECT_EQ(diagnostics.message().rfind("camera_info unusable", 0), 0u) << diagnostics.message();
 }
 
 TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
@@ -475,7 +482,10 @@ TEST_F(TrackerNodeletTest, TwoCamerasOnOneTopicAreReported) {
   }
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_GE(diagnostics.number("camera switches (total)") - before, 5);
-  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  // (The half-size images have no camera_info of their size: that is an ERROR of its own.)
+  EXPECT_GE(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(diagnostics.value("problem: last 10 s, camera switch"), "WARN: image stream mixes cameras")
+      << diagnostics.message();
 }
 
 // Issue 15, case 16: at 300 Hz the subscriber queue drops images; diagnostics count the
