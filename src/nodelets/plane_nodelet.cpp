@@ -22,6 +22,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <pluginlib/class_list_macros.hpp>
 
 #include "callback_guard.h"
@@ -57,6 +58,12 @@ std::string tfFrame(const std::string& frame_id) {
 
 std::string sizeText(const cv::Size& size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+std::string secondsText(double s) {
+  std::ostringstream text;
+  text << s << " s";
+  return text.str();
 }
 
 }  // namespace
@@ -781,16 +788,21 @@ class PlaneNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::WARN, "odometry", "no odometry: " + odom_tf_problem_);
     else if (odometry_stopped_)
       problems.add(DiagnosticStatus::WARN, "odometry",
-                   "odometry (" + odom_frame_ + ") stopped, or later than odom_wait_s: " +
+                   "odometry (" + odom_frame_ + ") stopped, or more than odom_wait_s (" +
+                       secondsText(odom_wait_s_) + ") behind the images: " +
                        (metric_source_ == "odometry"
                             ? std::string("camera pose from vision only")
                             : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
     if (state_ == PipelineState::kWaitingForTarget && waited_s_ > target_timeout_s_)
       problems.add(DiagnosticStatus::WARN, "metric start",
                    (node_.pipeline.pose.metric_source == "target"
-                        ? "start-up target not seen for "
-                        : "no metric start (" + status_ + ") for ") +
-                       std::to_string(static_cast<long>(waited_s_)) + " s");
+                        ? "start-up target not seen for " +
+                              std::to_string(static_cast<long>(waited_s_)) +
+                              " s: show it to the camera, or start the metres without it "
+                              "(metric_source odometry with odom_frame, or camera_height "
+                              "with camera_height_m)"
+                        : "no metric start (" + status_ + ") for " +
+                              std::to_string(static_cast<long>(waited_s_)) + " s"));
     if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
     for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
       problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);

@@ -265,7 +265,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
       why.precision(1);
       why << std::fixed << "no start-up target (" << params_.target.target_type << ") for "
           << targetWaitS() << " s: " << targetReason()
-          << "; planes stay in image space until one is seen";
+          << "; planes stay in image space until one is seen (or start the metres without "
+             "it: metric_source odometry or camera_height)";
       out.warnings.push_back({"target timeout", why.str()});
     }
   } else if (params_.detect_target) {
