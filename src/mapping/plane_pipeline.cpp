@@ -205,8 +205,9 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     std::ostringstream why;
     why.precision(2);
     why << std::fixed << "; too little parallax (" << result.parallax_px
-        << " px to every image within reach: nearly pure rotation or standing still): no "
-           "planes segmented";
+        << " px to every image within reach, under min_parallax_px "
+        << params_.min_parallax_px
+        << ": nearly pure rotation or standing still): no planes segmented";
     result.status += why.str();
   }
   return result;

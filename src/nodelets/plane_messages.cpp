@@ -254,8 +254,18 @@ visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, con
     label.ns = "labels";
     label.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     label.points.clear();
-    label.pose.position = point(centre + 0.35 * normal);
     label.scale.z = 0.12;
+    // A wall's label just above its top edge, a floor's or ceiling's off its centre: the
+    // centres of a floor and a wall standing on it often fall on one spot of rviz's view
+    // from above, and their texts were drawn over each other.
+    cv::Vec3d at = centre + 0.35 * normal;
+    if (planeKind(normal) == PlaneKind::kWall) {
+      double top = polygon.front()[2];
+      for (const auto& v : polygon) top = std::max(top, v[2]);
+      at = centre + 0.05 * normal;
+      at[2] = top + label.scale.z;
+    }
+    label.pose.position = point(at);
     label.color.r = label.color.g = label.color.b = label.color.a = 1;
     std::ostringstream text;
     text.precision(2);

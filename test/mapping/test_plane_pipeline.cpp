@@ -198,6 +198,7 @@ TEST(PlanePipeline, PureRotationIsReportedAndNotSegmented) {
         EXPECT_TRUE(r.planes.empty());
         EXPECT_NE(r.status.find("pure rotation"), std::string::npos) << r.status;
         EXPECT_NE(r.status.find("no planes segmented"), std::string::npos) << r.status;
+        EXPECT_NE(r.status.find("under min_parallax_px 4.00"), std::string::npos) << r.status;
         EXPECT_LT(r.parallax_px, pipeline.params().min_parallax_px);
       }
     }

@@ -729,4 +729,22 @@ TEST(PlaneMessages, SurfacesFaceTheSideTheyWereSeenFrom) {
     }
   }
   EXPECT_GE(triangles, 9);
+  // Wall labels above their top edge (the floor's label stood on the wall's in rviz).
+  int walls = 0;
+  for (const auto& m : markers->markers) {
+    if (m.ns != "labels") continue;
+    const bool is_wall = m.text.rfind("wall", 0) == 0;
+    double top = -1e9;
+    for (const auto& s : markers->markers)
+      if (s.ns == "planes" && s.id == m.id)
+        for (const auto& v : s.points) top = std::max(top, v.z);
+    if (is_wall) {
+      EXPECT_GT(m.pose.position.z, top + 0.5 * m.scale.z) << m.text;
+      EXPECT_LT(m.pose.position.z, top + 2 * m.scale.z) << m.text;
+    } else {  // (flat: its top is its height; 0.35 m off it along its normal)
+      EXPECT_NEAR(std::abs(m.pose.position.z - top), 0.35, 1e-6) << m.text;
+    }
+    walls += is_wall;
+  }
+  EXPECT_EQ(walls, 2);
 }
