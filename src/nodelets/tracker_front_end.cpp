@@ -78,6 +78,18 @@ std::string TrackerFrontEnd::targetReason() const {
   return target_startup_.lastDetection().reason;
 }
 
+std::string TrackerFrontEnd::targetDescription() const {
+  const TargetParams& t = params_.target;
+  std::ostringstream what;
+  what.precision(3);
+  if (t.target_type == "aruco")
+    what << "ArUco marker " << t.dictionary << " id " << t.marker_id << ", " << t.marker_size_m
+         << " m";
+  else
+    what << "a white sheet " << t.width_m << " x " << t.height_m << " m on a darker surface";
+  return what.str();
+}
+
 std::string TrackerFrontEnd::targetRejections() const {
   if (target_startup_.found()) return {};
   std::ostringstream out;
@@ -263,7 +275,7 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
     } else if (targetOverdue()) {
       std::ostringstream why;
       why.precision(1);
-      why << std::fixed << "no start-up target (" << params_.target.target_type << ") for "
+      why << std::fixed << "no start-up target (" << targetDescription() << ") for "
           << targetWaitS() << " s: " << targetReason()
           << "; planes stay in image space until one is seen (or start the metres without "
              "it: metric_source odometry or camera_height)";

@@ -72,6 +72,9 @@ class TrackerFrontEnd {
   std::string infoMismatch() const;
   bool targetFound() const { return target_startup_.found(); }
   const TargetStartup& targetStartup() const { return target_startup_; }
+  // What a user has to show the camera, from the target parameters ("a white sheet
+  // 0.297 x 0.21 m on a darker surface"): the log names it, not only the parameter.
+  std::string targetDescription() const;
   // Why the last image gave no target (empty once found or before any image).
   std::string targetReason() const;
   // The last image's candidates by rejection ("weak edge 12, bright surround 2"): which

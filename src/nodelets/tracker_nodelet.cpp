@@ -166,7 +166,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
           !front_.targetOverdue())
         NODELET_INFO_THROTTLE(10.0, "waiting for the start-up target (%s): %s",
-                              front_.params().target.target_type.c_str(),
+                              front_.targetDescription().c_str(),
                               front_.targetReason().c_str());
       if (!out.tracks) {
         // One throttle per reason: each kind of bad image is named at least once.

@@ -552,6 +552,10 @@ TEST(TrackerFrontEnd, NoTargetWarnsAfterTheTimeoutWithTheReason) {
       if (e.kind != "target timeout") continue;
       (k <= 20 ? warned_early : warned) = true;
       EXPECT_NE(e.text.find(front.targetReason()), std::string::npos) << e.text;
+      // What to show the camera, in plain words (a new user does not know the parameters).
+      EXPECT_NE(e.text.find("(a white sheet 0.297 x 0.21 m on a darker surface)"),
+                std::string::npos)
+          << e.text;
     }
     EXPECT_EQ(front.targetOverdue(), k > 20) << k;
   }
@@ -571,6 +575,8 @@ TEST(TrackerFrontEnd, NoTargetWarnsAfterTheTimeoutWithTheReason) {
   for (int k = 0; k <= 10; ++k) front.process(image(grey, 102 + k / 10, (k % 10) * 100000000));
   EXPECT_NEAR(front.targetWaitS(), 1.0 + 0.1 + 1.0, 1e-6);
   EXPECT_TRUE(front.targetOverdue());  // 2.1 s of images searched, over the 2 s
+  params.target.target_type = "aruco";
+  EXPECT_EQ(TrackerFrontEnd(params).targetDescription(), "ArUco marker DICT_4X4_50 id 0, 0.15 m");
 }
 
 // The focal length from camera_info reaches the detector: a square seen head-on is not an
