@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -330,6 +331,117 @@ TEST(TargetDetectorRealPhotos, FoundWithinTwoPixelsOfTheLabels) {
                 dark_only ? "dark surround only" : "default", found, expected,
                 sum_all / std::max(1, found), worst_all);
     EXPECT_EQ(found, expected);
+  }
+}
+
+// What a robot's camera does to the photos (darker, dimmer, brighter, less contrast,
+// defocus, motion blur, sensor noise, JPEG, a smaller view): how many of the 5 sheets are
+// still found, and how far their corners are from the labels (px of the image at 640 px
+// width). Measured with this detector (min_edge_snr 5; 8 before, which found 3 of 5 at
+// half size and under noise sigma 12). The misses named are the sheet's own (a light
+// surround that the gamma brightens past max_surround_ratio, a side at the image border).
+TEST(TargetDetectorRealPhotos, FoundUnderCameraDegradations) {
+  const auto labels = readLabels();
+  ASSERT_EQ(labels.size(), 5u);
+  auto lut = [](double gamma, double gain, double offset) {
+    cv::Mat table(1, 256, CV_8U);
+    for (int i = 0; i < 256; ++i)
+      table.at<uchar>(i) =
+          cv::saturate_cast<uchar>(gain * 255.0 * std::pow(i / 255.0, gamma) + offset);
+    return [table](const cv::Mat& m) {
+      cv::Mat o;
+      cv::LUT(m, table, o);
+      return o;
+    };
+  };
+  auto blur = [](double sigma) {
+    return [sigma](const cv::Mat& m) {
+      cv::Mat o;
+      cv::GaussianBlur(m, o, {0, 0}, sigma);
+      return o;
+    };
+  };
+  auto noise = [](double sigma) {
+    return [sigma](const cv::Mat& m) {
+      cv::Mat n(m.size(), CV_16S), o;
+      cv::RNG(3).fill(n, cv::RNG::NORMAL, 0, sigma);
+      m.convertTo(o, CV_16S);
+      o += n;
+      o.convertTo(o, CV_8U);
+      return o;
+    };
+  };
+  auto resized = [](double f) {
+    return [f](const cv::Mat& m) {
+      cv::Mat o;
+      cv::resize(m, o, {}, f, f, cv::INTER_AREA);
+      return o;
+    };
+  };
+  struct Degradation {
+    const char* name;
+    std::function<cv::Mat(const cv::Mat&)> apply;
+    int found;           // at least
+    double worst_px;     // corner error at most (at 640 px width)
+  };
+  const std::vector<Degradation> degradations = {
+      {"as is", [](const cv::Mat& m) { return m.clone(); }, 5, 2.0},
+      // test4's bottom-left corner lies 5.6 px from the image border: with the surround
+      // darkened its refinement has too little of it (6.6 px off; 0.7 px as is).
+      {"dark (gamma 2)", lut(2.0, 1, 0), 5, 7.0},
+      {"dim (x0.4)", lut(1.0, 0.4, 0), 5, 2.0},
+      {"bright (gamma 0.5)", lut(0.5, 1, 0), 3, 2.0},
+      {"low contrast (x0.5 + 60)", lut(1.0, 0.5, 60), 4, 2.0},
+      {"defocus (sigma 1.5)", blur(1.5), 5, 3.0},
+      {"defocus (sigma 3)", blur(3.0), 4, 6.0},
+      {"motion blur (9 px)",
+       [](const cv::Mat& m) {
+         cv::Mat k = cv::Mat::zeros(9, 9, CV_32F), o;
+         k.row(4).setTo(1.0 / 9);
+         cv::filter2D(m, o, -1, k);
+         return o;
+       },
+       5, 3.0},
+      {"noise (sigma 6)", noise(6), 5, 4.0},
+      {"noise (sigma 12)", noise(12), 4, 2.0},
+      {"jpeg 20",
+       [](const cv::Mat& m) {
+         std::vector<uchar> buf;
+         cv::imencode(".jpg", m, buf, {cv::IMWRITE_JPEG_QUALITY, 20});
+         return cv::imdecode(buf, cv::IMREAD_GRAYSCALE);
+       },
+       5, 2.0},
+      {"half size", resized(0.5), 4, 3.0},
+      {"quarter size", resized(0.25), 3, 4.0},
+  };
+  for (const Degradation& deg : degradations) {
+    int found = 0;
+    double worst_all = 0;
+    std::string missed;
+    for (const Labelled& l : labels) {
+      double scale = 1;
+      const cv::Mat clean =
+          loadAtWidth(std::string(TEST_DATA_DIR) + "/target_photos/" + l.file, 640, &scale);
+      ASSERT_FALSE(clean.empty()) << l.file;
+      const cv::Mat image = deg.apply(clean);
+      const double shrink = static_cast<double>(image.cols) / clean.cols;
+      const TargetDetection d = detectTarget(image, l.params);
+      if (!d.found) {
+        missed += " " + l.file + " (" + d.reason + ")";
+        continue;
+      }
+      ++found;
+      std::array<cv::Point2f, 4> in_file;
+      for (int i = 0; i < 4; ++i) in_file[i] = d.corners[i] / static_cast<float>(scale * shrink);
+      double mean = 0;
+      const double worst = worstCornerError(in_file, l.corners, &mean) * scale;  // px at 640
+      if (worst > 2) std::printf("    %s: worst corner %.2f px\n", l.file.c_str(), worst);
+      worst_all = std::max(worst_all, worst);
+    }
+    std::printf("%-26s found %d of 5, worst %.2f px (at 640)%s%s\n", deg.name, found, worst_all,
+                missed.empty() ? "" : "; missed:", missed.c_str());
+    EXPECT_GE(found, deg.found) << deg.name << ":" << missed;
+    EXPECT_LE(worst_all, deg.worst_px) << deg.name;
   }
 }
 
