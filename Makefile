@@ -63,7 +63,7 @@ demo: build
 # plane nodelets) under valgrind's helgrind, which sees every access and lock of the
 # whole process, Debian's uninstrumented ROS included. Fails when a racing access is
 # made by our code (scripts/helgrind_summary.py sorts the rest); XML reports in
-# build/ws_helgrind/reports. About 5 minutes.
+# build/ws_helgrind/reports. About 10 minutes.
 HG_WS := $(REPO)/build/ws_helgrind
 HG_SCALE ?= 20
 helgrind: deps

@@ -22,6 +22,18 @@ PACKAGES=(
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 
+# ROS from packages.ros.org (Ubuntu 20.04 / Noetic in /opt/ros): its package names are not
+# Debian's; rosdep maps package.xml's dependencies to them (after `rosdep init; rosdep update`).
+if compgen -G "/opt/ros/*/setup.bash" >/dev/null; then
+  repo="$(cd "$(dirname "$0")/.." && pwd)"
+  if command -v rosdep >/dev/null && rosdep install --from-paths "$repo" --ignore-src -y -q -r; then
+    exit 0
+  fi
+  echo "install_deps: ROS in /opt/ros: install package.xml's dependencies with" \
+       "'rosdep install --from-paths . --ignore-src -y' (the list: README.md, Build notes)" >&2
+  exit 0
+fi
+
 PACKAGES+=("$@")  # extra packages a target needs (make demo RVIZ=1: rviz)
 missing=()
 for p in "${PACKAGES[@]}"; do

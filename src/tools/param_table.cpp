@@ -1,20 +1,23 @@
 // Prints the parameter tables: `param_table --markdown` is docs/parameters.md,
 // `param_table --cfg` is cfg/Planes.cfg (dynamic_reconfigure).
-#include <cstring>
 #include <iostream>
 
+#include "cli_args.h"
 #include "mono_plane_detection/params/param_table.h"
 
+namespace cli = mono_plane_detection::cli;
+
 int main(int argc, char** argv) {
-  if (argc == 2 && std::strcmp(argv[1], "--markdown") == 0) {
-    std::cout << mono_plane_detection::parametersMarkdown();
-    return 0;
-  }
-  if (argc == 2 && std::strcmp(argv[1], "--cfg") == 0) {
-    std::cout << mono_plane_detection::dynamicReconfigureCfg();
-    return 0;
-  }
-  std::cerr << "usage: param_table --markdown   (prints docs/parameters.md)\n"
-               "       param_table --cfg        (prints cfg/Planes.cfg)\n";
-  return 2;
+  bool markdown = false, cfg = false;
+  cli::Parser cli("param_table", "--markdown | --cfg",
+                  "  Prints the parameter tables of both nodelets, the one declaration of every\n"
+                  "  parameter (name, default, range, unit, meaning).",
+                  "exit codes: 0 printed, 2 bad usage\n");
+  cli.flag("markdown", &markdown, "docs/parameters.md (param_table --markdown > docs/parameters.md)")
+      .flag("cfg", &cfg, "cfg/Planes.cfg, the dynamic_reconfigure parameters (then chmod +x it)");
+  if (const auto code = cli.parse(argc, argv)) return *code;
+  if (markdown == cfg) return cli.fail("give one of --markdown and --cfg");
+  std::cout << (markdown ? mono_plane_detection::parametersMarkdown()
+                         : mono_plane_detection::dynamicReconfigureCfg());
+  return 0;
 }

@@ -37,7 +37,7 @@ struct TrackerParams {
 
   // Pyramidal Lucas-Kanade (paper II-C).
   int pyramid_levels = 5;             // levels including full resolution (paper: 5)
-  int window_size_px = 7;             // paper: 3; 7 measured best (README, "LK window size")
+  int window_size_px = 7;             // paper: 3; 7 measured best (docs/benchmarks.md, "LK window size")
   int max_iterations = 30;            // LK termination: iterations per level
   double epsilon_px = 0.01;           // LK termination: step size
   double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
