@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
                   "exit codes: 0 done, 2 bad usage, an unreadable image or an unwritable output file\n");
   cli.positional("IMG1", &img1, "first image").positional("IMG2", &img2, "second image");
   cli.text("profile", &profile.name, profileHelp("planes"), "P");
-  cli.number("fx", &in1.fx, 1e-6, 1e6, "focal length x, pixels", "PX")
-      .number("fy", &in1.fy, 1e-6, 1e6, "focal length y, pixels", "PX")
+  cli.number("fx", &in1.fx, 1e-6, 1e6, "focal length x, pixels (required)", "PX")
+      .number("fy", &in1.fy, 1e-6, 1e6, "focal length y, pixels (required)", "PX")
       .number("cx", &in1.cx, -1e6, 1e6, "principal point x, pixels", "PX")
       .number("cy", &in1.cy, -1e6, 1e6, "principal point y, pixels", "PX")
       .number("k1", &in1.k1, -100, 100, "radial distortion").number("k2", &in1.k2, -100, 100, "radial distortion")

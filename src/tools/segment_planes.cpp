@@ -73,8 +73,8 @@ int main(int argc, char** argv) {
       .flag("no-epipolar-check", &params.epipolar_check,
             "keep planes whose points are off the epipolar lines of the planes' F", false)
       .integer("max-planes", &params.max_planes, 1, 1000, "at most K planes", "K")
-      .integer("min-support", &params.min_plane_support, 4, 1000000,
-               "a plane needs at least N points")
+      .integer("min-support", &params.min_plane_support, 5, 100000,
+               "a plane needs at least N points (planes/min_plane_support's range)")
       .number("invariant-threshold", &params.groups.invariant_threshold, 1e-6, 10.0,
               "five-point invariant agreement", "T")
       .integer<unsigned>("seed", &params.groups.seed, 0, std::numeric_limits<unsigned>::max(),
