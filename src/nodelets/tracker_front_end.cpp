@@ -60,9 +60,7 @@ TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
 
 std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) {
   std::string error = cameraInfoError(info);
-  // The target is searched with the lens undone (straight sides) and its aspect judged
-  // with the focal length of the pixels it is searched in: a raw image's K and D, a
-  // rectified one's P (image_geometry's camera model).
+  // A raw image's K and D, a rectified one's P (image_geometry's camera model).
   CameraIntrinsics lens;
   if (error.empty()) error = intrinsicsFromCameraInfo(info, rectified_, lens);
   if (error.empty()) calibration_.offer(lens);  // (binning and ROI applied)
