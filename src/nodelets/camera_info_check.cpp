@@ -140,7 +140,7 @@ std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_si
 }
 
 const CameraIntrinsics* CalibrationHolder::heldFor(const cv::Size& size) const {
-  if (latest_ && latest_->size == size) return &*latest_;
+  if (latest_ && (latest_->size == size || size.empty())) return &*latest_;
   return held_ && held_->size == size ? &*held_ : nullptr;
 }
 

@@ -57,7 +57,8 @@ class CalibrationHolder {
   // For images of `size`: the calibration to use (null: none, image-space planes), and
   // in `mismatch` the ERROR when the last camera_info is of another size.
   const CameraIntrinsics* forImages(const cv::Size& size, std::string& mismatch);
-  // The same without taking the last camera_info (diagnostics).
+  // The same without taking the last camera_info (diagnostics); no size (no images
+  // yet): the last camera_info.
   const CameraIntrinsics* heldFor(const cv::Size& size) const;
   std::string mismatch(const cv::Size& size) const;
   const std::optional<CameraIntrinsics>& latest() const { return latest_; }

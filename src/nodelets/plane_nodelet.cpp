@@ -27,6 +27,7 @@
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
+#include "stretched_wait.h"
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/SaveMap.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
@@ -277,8 +278,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   void mapStartedOver() {
     markers_shown_.clear();
     reset_markers_ = true;
-    waiting_since_ = -1;
-    waited_before_s_ = waited_s_ = 0;
+    target_wait_.reset();
   }
 
   // A log line at most once per period_s of wall time per kind: ROS's _THROTTLE macros
@@ -697,19 +697,13 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
       }
-      // Waited in tracks stamps over the stretches of the stream: a pause or a jump of the
-      // stamps (another bag, a driver's clock) closes one and is no waiting (it said
-      // "not seen for 100000011 s" after stamps jumped forward).
+      // Waited in tracks stamps over the stretches of the stream (a pause or a jump of the
+      // stamps is a tracking loss: it closes one).
       if (result.state == PipelineState::kWaitingForTarget) {
-        if (result.tracking_loss && waiting_since_ >= 0) {
-          waited_before_s_ = waited_s_;
-          waiting_since_ = -1;
-        }
-        if (waiting_since_ < 0) waiting_since_ = frame.stamp;
-        waited_s_ = waited_before_s_ + (frame.stamp - waiting_since_);
+        if (result.tracking_loss) target_wait_.closeStretch();
+        target_wait_.seen(frame.stamp);
       } else {
-        waiting_since_ = -1;
-        waited_before_s_ = waited_s_ = 0;
+        target_wait_.reset();
       }
       ++frames_;
       status_ = result.status;
@@ -793,16 +787,17 @@ class PlaneNodelet : public nodelet::Nodelet {
                        (metric_source_ == "odometry"
                             ? std::string("camera pose from vision only")
                             : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
-    if (state_ == PipelineState::kWaitingForTarget && waited_s_ > target_timeout_s_)
+    const double waited_s = target_wait_.seconds();  // (0 unless waiting for the start)
+    if (state_ == PipelineState::kWaitingForTarget && waited_s > target_timeout_s_)
       problems.add(DiagnosticStatus::WARN, "metric start",
                    (node_.pipeline.pose.metric_source == "target"
                         ? "start-up target not seen for " +
-                              std::to_string(static_cast<long>(waited_s_)) +
+                              std::to_string(static_cast<long>(waited_s)) +
                               " s: show it to the camera, or start the metres without it "
                               "(metric_source odometry with odom_frame, or camera_height "
                               "with camera_height_m)"
                         : "no metric start (" + status_ + ") for " +
-                              std::to_string(static_cast<long>(waited_s_)) + " s"));
+                              std::to_string(static_cast<long>(waited_s)) + " s"));
     if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
     for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
       problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
@@ -817,9 +812,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
     // The calibration of the last tracks' size (before any: the last camera_info).
-    const CameraIntrinsics* held = last_tracks_size_.empty()
-                                       ? (calibration_.latest() ? &*calibration_.latest() : nullptr)
-                                       : calibration_.heldFor(last_tracks_size_);
+    const CameraIntrinsics* held = calibration_.heldFor(last_tracks_size_);
     status.add("camera model", !calibration_.latest()     ? "none"
                                : !held                    ? "not used: camera_info for another image size"
                                : held->rectified          ? "rectified (P)"
@@ -885,7 +878,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   CalibrationHolder calibration_;       // the usable camera_infos
   long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
   long backwards_resets_ = 0;           // map resets because time went backwards
-  double waited_before_s_ = 0;          // in earlier stretches of the stream (tracks stamps), s
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   bool clock_went_back_ = false;        // since the last tracks (fromBeforeClockJump)
@@ -899,7 +891,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
   std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
-  double waiting_since_ = -1, waited_s_ = 0;  // tracks stamps, s
+  StretchedWait target_wait_;  // for the metric start, in tracks stamps
   std::optional<Pose> last_odom_;
   ros::Time last_odom_stamp_;
   std::string last_frame_id_;

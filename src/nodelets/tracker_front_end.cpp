@@ -101,19 +101,7 @@ std::string TrackerFrontEnd::targetRejections() const {
 }
 
 double TrackerFrontEnd::targetWaitS() const {
-  if (target_startup_.found()) return 0;
-  const double stretch =
-      target_wait_start_ns_ == 0
-          ? 0.0
-          : static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
-  return target_waited_before_s_ + stretch;
-}
-
-void TrackerFrontEnd::closeTargetWait() {
-  if (target_wait_start_ns_ != 0)
-    target_waited_before_s_ +=
-        static_cast<double>(target_wait_last_ns_ - target_wait_start_ns_) * 1e-9;
-  target_wait_start_ns_ = target_wait_last_ns_ = 0;
+  return target_startup_.found() ? 0.0 : target_wait_.seconds();
 }
 
 bool TrackerFrontEnd::targetOverdue() const {
@@ -124,8 +112,7 @@ bool TrackerFrontEnd::targetOverdue() const {
 void TrackerFrontEnd::reset() {
   tracker_.reset();
   target_startup_.reset();
-  target_wait_start_ns_ = target_wait_last_ns_ = 0;
-  target_waited_before_s_ = 0;
+  target_wait_.reset();
   heard_ns_ = 0;
   last_stamp_ns_ = 0;
   last_size_ = cv::Size();
@@ -138,7 +125,7 @@ void TrackerFrontEnd::reset() {
 void TrackerFrontEnd::startOver(uint64_t stamp_ns, bool new_rhythm) {
   tracker_.reset();
   target_startup_.reset();
-  closeTargetWait();
+  target_wait_.closeStretch();
   if (!new_rhythm) return;
   gaps_.reset();
   heard_ns_ = stamp_ns;
@@ -259,9 +246,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   // tracked points flagged as target corners.
   if (params_.detect_target && !target_startup_.found()) {
     // The wait counts in image stamps over the stretches searched since the last reset()
-    // (a jump or pause of the stamps closes one: its length is no waiting).
-    if (target_wait_start_ns_ == 0) target_wait_start_ns_ = stamp_ns;
-    target_wait_last_ns_ = stamp_ns;
+    // (a jump or pause of the stamps closes one: startOver()).
+    target_wait_.seen(static_cast<double>(stamp_ns) * 1e-9);
     if (const auto target =
             target_startup_.process(image, tracker_, focal_px, principal_px)) {
       std::ostringstream what;

@@ -15,6 +15,7 @@
 
 #include "camera_info_check.h"
 #include "image_input.h"
+#include "stretched_wait.h"
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/params/param_table.h"
 #include "mono_plane_detection/tracking/feature_tracker.h"
@@ -102,12 +103,7 @@ class TrackerFrontEnd {
   // The usable camera_infos (K and D, or P when rectified): the lens the target is
   // undistorted with, given to the target start-up only for images of its size.
   CalibrationHolder calibration_;
-  uint64_t target_wait_start_ns_ = 0;  // first image searched for the target, 0: none
-  uint64_t target_wait_last_ns_ = 0;
-  // Waited in earlier stretches of the stream, s: a jump of the stamps (bag loop, a bad
-  // driver clock) or a pause closes a stretch; the jump itself is no waiting.
-  double target_waited_before_s_ = 0;
-  void closeTargetWait();
+  StretchedWait target_wait_;  // images searched for the target (stamps)
   GapCounter gaps_;
   TrackerCounts counts_;
 };

@@ -14,6 +14,7 @@
 #include "../../src/nodelets/nodelet_diagnostics.h"
 #include "../../src/nodelets/plane_messages.h"
 #include "../../src/nodelets/recent_events.h"
+#include "../../src/nodelets/stretched_wait.h"
 #include "../../src/nodelets/tracker_front_end.h"
 #include "mono_plane_detection/sim/synthetic_views.h"
 #include "mono_plane_detection/tracking/target_detector.h"
@@ -272,6 +273,26 @@ TEST(CalibrationHolder, TheLastCameraInfoOfTheImagesSizeIsUsed) {
   ASSERT_NE(used, nullptr);
   EXPECT_EQ(used->K(0, 0), 510);
   EXPECT_EQ(holder.mismatch({0, 0}), "");  // no images yet: nothing to compare
+  ASSERT_NE(holder.heldFor({0, 0}), nullptr);  // and the last camera_info is the one held
+  EXPECT_EQ(holder.heldFor({0, 0})->K(0, 0), 510);
+  EXPECT_EQ(CalibrationHolder().heldFor({0, 0}), nullptr);
+}
+
+// The target's wait counts the stretches of the stream, not a pause or a jump between them.
+TEST(StretchedWait, CountsTheStretchesNotTheJumps) {
+  StretchedWait wait;
+  EXPECT_EQ(wait.seconds(), 0.0);
+  for (int k = 0; k <= 20; ++k) wait.seen(100 + 0.1 * k);  // 2 s
+  EXPECT_NEAR(wait.seconds(), 2.0, 1e-9);
+  wait.closeStretch();  // a jump of 1e8 s
+  wait.closeStretch();  // (twice: no change)
+  EXPECT_NEAR(wait.seconds(), 2.0, 1e-9);
+  for (int k = 0; k <= 10; ++k) wait.seen(1e8 + 0.1 * k);  // 1 s more
+  EXPECT_NEAR(wait.seconds(), 3.0, 1e-6);
+  wait.reset();
+  EXPECT_EQ(wait.seconds(), 0.0);
+  wait.seen(5);
+  EXPECT_EQ(wait.seconds(), 0.0);  // one message: no time yet
 }
 
 // What went wrong lately: one log per kind and period, and every kind still recent with
