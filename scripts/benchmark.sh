@@ -37,6 +37,10 @@ echo "== tracker against the floor (glibc malloc defaults)"
 rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor.png"
 echo
+echo "== the same with predict_motion (off by default: docs/benchmarks.md, eighth round)"
+rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" --predict-motion 1 \
+  --plot "$results/benchmark_tracker_floor_predict_motion.png"
+echo
 bag=$results/latency_sequence.bag
 [ -f "$bag" ] || rosrun mono_plane_detection make_sequence --trajectory wheeled --frames 300 \
   --noise 2 --out "$bag" --quiet

@@ -4,6 +4,7 @@
 //   rosrun mono_plane_detection benchmark_tracker_floor [--frames N] [--euroc F] [--tum F]
 //     [--size WxH] [--features N]   (one row, e.g. to profile it)
 //     [--spread N]   (the tracker's search_spread_images; default: the tracker's default)
+//     [--predict-motion 0|1]   (the tracker's predict_motion; default: the tracker's default)
 //     [--noise-seed N]   (another draw of the sensor noise: how much a figure moves by chance)
 //     [--phase N]   (the swing starts N images on: the search images meet other motion)
 //
@@ -144,11 +145,10 @@ struct RowResult {
   double ratio = 0;  // ours / floor mean time
 };
 
-RowResult runRow(const Sequence& seq, int features, int spread) {
+RowResult runRow(const Sequence& seq, int features, const TrackerParams& base) {
   RowResult r;
-  TrackerParams params;
+  TrackerParams params = base;
   params.max_features = features;
-  if (spread > 0) params.search_spread_images = spread;
   FeatureTracker tracker(params);
   TrackScorer score;
   Record ours, floor;
@@ -214,9 +214,9 @@ RowResult runRow(const Sequence& seq, int features, int spread) {
 
 // The median of `repeats` runs of a row, figure by figure (the machine is shared: one
 // run can be slowed by others).
-RowResult medianRow(const Sequence& seq, int features, int spread, int repeats) {
+RowResult medianRow(const Sequence& seq, int features, const TrackerParams& base, int repeats) {
   std::vector<RowResult> runs;
-  for (int r = 0; r < repeats; ++r) runs.push_back(runRow(seq, features, spread));
+  for (int r = 0; r < repeats; ++r) runs.push_back(runRow(seq, features, base));
   auto median = [&](auto get) {
     std::vector<double> v;
     for (const auto& r : runs) v.push_back(get(r));
@@ -306,7 +306,7 @@ int main(int argc, char** argv) {
   int count = 150, repeats = 3;
   std::string plot_path = "benchmark_tracker_floor.png";
   std::string euroc, tum, only_size;
-  int only_features = 0, spread = 0, noise_seed = 7, phase_images = 0;
+  int only_features = 0, spread = 0, noise_seed = 7, phase_images = 0, predict = -1;
   cli::Parser cli("benchmark_tracker_floor", "[options]",
                   "  The tracker against goodFeaturesToTrack every 10 images +\n"
                   "  calcOpticalFlowPyrLK, on generated texture and on real images moved by\n"
@@ -320,6 +320,8 @@ int main(int argc, char** argv) {
       .integer("features", &only_features, 0, 100000, "only the rows of this count (0: all)")
       .integer("spread", &spread, 0, 100,
                "the tracker's search_spread_images (0: the tracker's default)")
+      .integer("predict-motion", &predict, -1, 1,
+               "the tracker's predict_motion, 0 or 1 (-1: the tracker's default)")
       .integer("noise-seed", &noise_seed, 0, 1000000,
                "seed of the sensor noise (the quality figures of one seed move by chance: "
                "compare several)")
@@ -328,6 +330,9 @@ int main(int argc, char** argv) {
                "motion: which returning points a search finds first depends on it)");
   if (const auto code = cli.parse(argc, argv)) return *code;
   cv::setNumThreads(1);
+  TrackerParams base;
+  if (spread > 0) base.search_spread_images = spread;
+  if (predict >= 0) base.predict_motion = predict == 1;
 
   std::vector<std::pair<std::string, cv::Mat>> sources;
   sources.push_back({"generated", makeCornerTexture({1024, 768}, 42)});
@@ -353,10 +358,10 @@ int main(int argc, char** argv) {
       "ours / the floor's; n/s = mean ms on images without / with a search, ours and floor's.\n\n",
       count, repeats, kSteadyFrom);
   std::printf(
-      "search_spread_images %d, noise seed %d, phase %d\n"
+      "search_spread_images %d, predict_motion %d, noise seed %d, phase %d\n"
       "%-9s %-7s %4s | %19s %5s %19s | %19s %5s %19s | %5s %5s | %5s %5s %5s %7s %5s %4s %7s %11s "
       "%11s\n",
-      spread > 0 ? spread : TrackerParams().search_spread_images, noise_seed, phase_images,
+      base.search_spread_images, base.predict_motion ? 1 : 0, noise_seed, phase_images,
       "source", "image", "feat", "ours ms mean/p95/max", "wall", "alloc n/s, kB n/s",
       "floor mean/p95/max", "wall", "alloc n/s, kB n/s", "ratio", "p95/m", "err", "p95e", "kept",
       "ids100", "reid", "srch", "pts o/f", "ours n/s", "floor n/s");
@@ -367,7 +372,7 @@ int main(int argc, char** argv) {
       const Sequence seq = makeSequence(texture, size, count, noise_seed, phase_images);
       for (int features : {50, 150, 500}) {
         if (only_features > 0 && features != only_features) continue;
-        Row row{name, size, features, medianRow(seq, features, spread, repeats)};
+        Row row{name, size, features, medianRow(seq, features, base, repeats)};
         const RowResult& r = row.result;
         auto alloc = [](const Timing& t) {
           return cv::format("%3.0f/%3.0f %4.0f/%4.0f", t.allocations, t.search_allocations,

@@ -1,6 +1,7 @@
 #include "mono_plane_detection/tracking/feature_tracker.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,6 +17,10 @@ namespace {
 const cv::TermCriteria kSubPixCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.01);
 // The short backward pass of the forward-backward check: levels 0 and 1.
 const int kShortCheckLevel = 1;
+// predict_motion: the points whose full pass measures the image's motion (the median of
+// 12 stays right with 5 of them wrong); with fewer than three times as many points the
+// full pass runs on all.
+const size_t kMotionSample = 12;
 
 // The median image motion, per axis, of the displacements dx, dy (reordered in place:
 // the tracker's kept buffers, no copy); zero when there are none.
@@ -172,6 +177,13 @@ int FeatureTracker::movePoints(const std::vector<std::uint64_t>& ids,
   return moved;
 }
 
+// Beyond the paper (predict_motion): most points move nearly as the image does, so the
+// image's motion is measured first, by the paper's full pyramidal pass on a sample of
+// the points, and the others start from it on only as many pyramid levels as the
+// sample's spread about it needs (a pass costs mostly its per-level window set-up: three
+// levels fewer is most of it). The points this short pass or the forward-backward check
+// does not keep get the full pass from their old position, so a point whose own motion
+// is far from the image's costs time, not its track.
 void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
   if (previous_.empty()) return;
@@ -180,29 +192,35 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                   params_.max_iterations, params_.epsilon_px);
   const std::vector<cv::Point2f>& before = positionsOf(previous_, before_);
-  std::vector<cv::Point2f>& after = after_;
-  std::vector<uchar>& status = status_;
-  cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after, status, error_, window,
-                           max_level, criteria, 0, params_.min_eigen_threshold);
-
-  if (params_.forward_backward_check) checkBackward(previous_pyramid, pyramid);
-  std::vector<uchar>& back_status = back_status_;
-  std::vector<cv::Point2f>& back = back_;
-
-  const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
-  for (size_t i = 0; i < previous_.size(); ++i) {
-    bool ok = status[i] && inside(after[i], size);
-    if (ok && params_.forward_backward_check) {
-      const cv::Point2f d = back[i] - before[i];
-      ok = back_status[i] && d.dot(d) <= fb_max2;
+  const int level = params_.predict_motion ? measureImageMotion(previous_pyramid, pyramid, size)
+                                           : max_level;
+  const bool predicted = level < max_level;
+  if (predicted) {
+    // The sample keeps its own full-pass results (recheck_*_ from measureImageMotion).
+    after_.resize(before.size());
+    for (size_t i = 0; i < before.size(); ++i) after_[i] = before[i] + image_motion_;
+    cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after_, status_, error_, window,
+                             level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                             params_.min_eigen_threshold);
+    for (size_t k = 0; k < recheck_index_.size(); ++k) {
+      after_[recheck_index_[k]] = recheck_to_[k];
+      status_[recheck_index_[k]] = recheck_status_[k];
     }
-    if (!ok) {
+  } else {
+    cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after_, status_, error_, window,
+                             max_level, criteria, 0, params_.min_eigen_threshold);
+  }
+  if (params_.forward_backward_check) checkBackward(previous_pyramid, pyramid);
+  if (predicted) retryOnFullPyramid(previous_pyramid, pyramid, size);
+
+  for (size_t i = 0; i < previous_.size(); ++i) {
+    if (!followed(i, size)) {
       rememberLost(previous_[i]);
       ++stats_.lost;
       continue;
     }
     TrackedPoint p = previous_[i];
-    p.uv = after[i];
+    p.uv = after_[i];
     p.is_new = false;
     p.is_tracked = true;
     p.is_reidentified = false;  // (is_target_corner stays: it is the same point)
@@ -211,7 +229,99 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
     current_.push_back(p);
   }
   stats_.tracked = static_cast<int>(current_.size());
+  stats_.lk_levels = level + 1;
   moveLostWithImage();
+}
+
+bool FeatureTracker::followed(size_t i, const cv::Size& size) const {
+  if (!status_[i] || !inside(after_[i], size)) return false;
+  if (!params_.forward_backward_check) return true;
+  const cv::Point2f d = back_[i] - before_[i];
+  const double fb_max = params_.forward_backward_max_px;
+  return back_status_[i] && d.dot(d) <= fb_max * fb_max;
+}
+
+// The full pass on kMotionSample points spread through previous_ (their results stay in
+// recheck_index_ / recheck_to_ / recheck_status_); image_motion_ their median motion.
+// Returns the pyramid level the others start from: the smallest from which Lucas-Kanade
+// reaches twice the sample's 90th percentile distance from that motion plus a pixel
+// (from level L a window of half-size h reaches about h (2^(L+1) - 1) px), at least that
+// of the backward short pass; the full pyramid when there are too few points, or too
+// few of the sample followed, to measure it.
+int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyramid,
+                                       const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
+  const int max_level = std::max(0, params_.pyramid_levels - 1);
+  recheck_index_.clear();
+  const size_t n = before_.size();
+  if (n < 3 * kMotionSample || max_level <= kShortCheckLevel) return max_level;
+  recheck_from_.clear();
+  for (size_t k = 0; k < kMotionSample; ++k) {
+    recheck_index_.push_back(static_cast<int>(k * n / kMotionSample));
+    recheck_from_.push_back(before_[recheck_index_.back()]);
+  }
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params_.max_iterations, params_.epsilon_px);
+  cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_,
+                           error_, window, max_level, criteria, 0, params_.min_eigen_threshold);
+  motion_x_.clear();
+  motion_y_.clear();
+  for (size_t k = 0; k < kMotionSample; ++k) {
+    if (!recheck_status_[k] || !inside(recheck_to_[k], size)) continue;
+    motion_x_.push_back(recheck_to_[k].x - recheck_from_[k].x);
+    motion_y_.push_back(recheck_to_[k].y - recheck_from_[k].y);
+  }
+  if (motion_x_.size() < kMotionSample / 2) return max_level;
+  sample_motion_.clear();
+  for (size_t k = 0; k < motion_x_.size(); ++k) sample_motion_.emplace_back(motion_x_[k], motion_y_[k]);
+  image_motion_ = medianMotion(motion_x_, motion_y_);
+  motion_x_.clear();  // (now the distances from the median motion)
+  for (const cv::Point2f& d : sample_motion_)
+    motion_x_.push_back(std::hypot(d.x - image_motion_.x, d.y - image_motion_.y));
+  const size_t q = motion_x_.size() * 9 / 10;
+  std::nth_element(motion_x_.begin(), motion_x_.begin() + q, motion_x_.end());
+  const double needed = 2.0 * motion_x_[q] + 1.0;
+  const int half = params_.window_size_px / 2;  // (the window's side is odd)
+  for (int level = kShortCheckLevel; level < max_level; ++level) {
+    if (half * ((2 << level) - 1) >= needed) return level;
+  }
+  return max_level;
+}
+
+// The paper's full pyramidal pass, from the old position, for the points the short pass
+// from the prediction did not keep, with the full backward pass as their check.
+void FeatureTracker::retryOnFullPyramid(const std::vector<cv::Mat>& previous_pyramid,
+                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
+  recheck_index_.clear();
+  recheck_from_.clear();
+  for (size_t i = 0; i < before_.size(); ++i) {
+    if (followed(i, size)) continue;
+    recheck_index_.push_back(static_cast<int>(i));
+    recheck_from_.push_back(before_[i]);
+  }
+  stats_.lk_retried = static_cast<int>(recheck_index_.size());
+  if (recheck_index_.empty()) return;
+  const cv::Size window(params_.window_size_px, params_.window_size_px);
+  const int max_level = std::max(0, params_.pyramid_levels - 1);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  params_.max_iterations, params_.epsilon_px);
+  cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_,
+                           error_, window, max_level, criteria, 0, params_.min_eigen_threshold);
+  if (params_.forward_backward_check) {
+    recheck_back_ = recheck_to_;
+    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, recheck_to_, recheck_back_,
+                             recheck_back_status_, error_, window, max_level, criteria,
+                             cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
+  }
+  for (size_t k = 0; k < recheck_index_.size(); ++k) {
+    const int i = recheck_index_[k];
+    after_[i] = recheck_to_[k];
+    status_[i] = recheck_status_[k];
+    if (params_.forward_backward_check) {
+      back_[i] = recheck_back_[k];
+      back_status_[i] = recheck_back_status_[k];
+    }
+  }
 }
 
 // The forward-backward check without a second full pyramidal pass (which cost as much

@@ -438,3 +438,93 @@ TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
   EXPECT_GE(parts_seen[3], 2);
   EXPECT_EQ(parts_seen[0], 0);
 }
+
+// predict_motion: the image's motion measured on a sample, the other points start from
+// it on fewer pyramid levels, and follow as many points as the full pyramid, as exactly.
+TEST(FeatureTracker, PredictedMotionTracksOnFewerLevelsAsWellAsTheFullPyramid) {
+  auto run = [](bool predict) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.predict_motion = predict;
+    FeatureTracker tracker(params);
+    return runOnViews(tracker, texture(), translations(40, kCentred, {6.0, -2.5}, 0.002), kView);
+  };
+  const auto predicted = run(true), full = run(false);
+  int short_images = 0, tracked_predicted = 0, tracked_full = 0;
+  for (size_t k = 1; k < full.stats.size(); ++k) {
+    EXPECT_EQ(full.stats[k].lk_levels, 5) << "image " << k;
+    short_images += predicted.stats[k].lk_levels <= 2;
+    tracked_predicted += predicted.stats[k].tracked;
+    tracked_full += full.stats[k].tracked;
+  }
+  EXPECT_GE(short_images, 38);
+  EXPECT_GE(tracked_predicted, tracked_full * 99 / 100);
+  ASSERT_GT(predicted.score.errors().size(), 3000u);
+  EXPECT_LT(predicted.score.meanError(), 0.2);
+  EXPECT_LT(predicted.score.meanError(), full.score.meanError() + 0.01);
+  EXPECT_LT(percentile(predicted.score.errors(), 0.99), 1.0);
+}
+
+// A jolt (a bump: 40 px in one image after 2 px per image) is measured by the sample, so
+// the short pass starts from it: no track lost, none misplaced.
+TEST(FeatureTracker, AJoltIsMeasuredNotPredicted) {
+  std::vector<cv::Matx33d> hs = translations(12, kCentred, {2.0, 1.0});
+  const cv::Point2d jolted = kCentred + cv::Point2d(11 * 2.0 + 40.0, 11 * 1.0 - 10.0);
+  for (int k = 0; k < 6; ++k) hs.push_back(similarity(0, {}, jolted + k * cv::Point2d(2.0, 1.0)));
+  auto run = [&](bool predict) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.predict_motion = predict;
+    FeatureTracker tracker(params);
+    return runOnViews(tracker, texture(), hs, kView);
+  };
+  const auto predicted = run(true), full = run(false);
+  const size_t jolt = 12;
+  EXPECT_LE(predicted.stats[jolt].lk_levels, 2);
+  EXPECT_GE(predicted.stats[jolt].tracked, full.stats[jolt].tracked * 98 / 100);
+  EXPECT_GE(predicted.stats[jolt].tracked, 100);
+  ASSERT_GT(predicted.score.errors().size(), 1500u);
+  EXPECT_LT(predicted.score.meanError(), 0.2);
+  EXPECT_LT(predicted.score.meanError(), full.score.meanError() + 0.01);
+}
+
+// Points that move unlike the image (an object crossing: a patch 20 px off the image's
+// motion) fail the short pass and get the full pyramid: followed to where they went.
+TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
+  const cv::Rect patch(380, 60, 170, 170);
+  const cv::Point2d image_step(3, 2), patch_step(23, 12);
+  auto run = [&](bool predict) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.predict_motion = predict;
+    FeatureTracker tracker(params);
+    tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
+    const std::vector<TrackedPoint> first = tracker.current();
+    cv::Mat second = warpView(texture(), similarity(0, {}, kCentred + image_step), kView);
+    warpView(texture(), similarity(0, {}, kCentred + patch_step), kView)(patch).copyTo(second(patch));
+    tracker.process(second);
+    int inside = 0, followed = 0, right = 0;
+    for (const auto& p : first) {
+      const cv::Point2f to = p.uv + cv::Point2f(patch_step);
+      const cv::Rect inner(patch.x + 12, patch.y + 12, patch.width - 24, patch.height - 24);
+      if (!inner.contains(p.uv) || !inner.contains(to)) continue;
+      ++inside;
+      for (const auto& q : tracker.current()) {
+        if (q.id != p.id) continue;
+        ++followed;
+        right += cv::norm(q.uv - to) < 0.3;
+      }
+    }
+    return std::array<int, 5>{inside, followed, right, tracker.lastStats().lk_levels,
+                              tracker.lastStats().lk_retried};
+  };
+  const auto predicted = run(true), full = run(false);
+  ASSERT_GE(full[0], 5);
+  EXPECT_EQ(full[2], full[0]);  // the full pyramid follows them all
+  EXPECT_LE(predicted[3], 2) << "the short pass ran";
+  // (At most one of them is in the sample, which had the full pass already: with two
+  // the sample's spread would have asked for the full pyramid for all.)
+  EXPECT_GE(predicted[4], predicted[0] - 1) << "they were retried";
+  EXPECT_EQ(predicted[1], predicted[0]);
+  EXPECT_EQ(predicted[2], predicted[0]);
+}
