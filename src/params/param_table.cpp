@@ -103,8 +103,8 @@ const ParamTable<TrackerParams>& trackerParamTable() {
        "LK drops points whose gradient matrix is flatter"},
       {"predict_motion", field(&P::predict_motion), 0, 1, "",
        "LK measures the image's motion on 12 points, starts the others from it on the "
-       "pyramid levels its spread needs; points that pass loses get the full pyramid "
-       "(faster; docs/benchmarks.md, eighth round)"},
+       "pyramid levels its spread needs; the points this short pass loses get the full "
+       "pyramid (faster; docs/benchmarks.md, eighth round)"},
       {"redetect_lost_fraction", field(&P::redetect_lost_fraction), 0, 1, "",
        "search again when this share of the last search's points is lost (paper: 2/3)"},
       {"redetect_every", field(&P::redetect_every), 1, 100000, "images",

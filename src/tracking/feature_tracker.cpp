@@ -192,9 +192,10 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                   params_.max_iterations, params_.epsilon_px);
   const std::vector<cv::Point2f>& before = positionsOf(previous_, before_);
+  const int full_level = std::min(max_level, levels_built_);
   const int level = params_.predict_motion ? measureImageMotion(previous_pyramid, pyramid, size)
-                                           : max_level;
-  const bool predicted = level < max_level;
+                                           : full_level;
+  const bool predicted = level < full_level;
   if (predicted) {
     // The sample keeps its own full-pass results (recheck_*_ from measureImageMotion).
     after_.resize(before.size());
@@ -250,7 +251,8 @@ bool FeatureTracker::followed(size_t i, const cv::Size& size) const {
 // few of the sample followed, to measure it.
 int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyramid,
                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
-  const int max_level = std::max(0, params_.pyramid_levels - 1);
+  // (The pyramid of a small image has fewer levels than asked for.)
+  const int max_level = std::min(std::max(0, params_.pyramid_levels - 1), levels_built_);
   recheck_index_.clear();
   const size_t n = before_.size();
   if (n < 3 * kMotionSample || max_level <= kShortCheckLevel) return max_level;
@@ -273,7 +275,8 @@ int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyra
   }
   if (motion_x_.size() < kMotionSample / 2) return max_level;
   sample_motion_.clear();
-  for (size_t k = 0; k < motion_x_.size(); ++k) sample_motion_.emplace_back(motion_x_[k], motion_y_[k]);
+  for (size_t k = 0; k < motion_x_.size(); ++k)
+    sample_motion_.emplace_back(motion_x_[k], motion_y_[k]);
   image_motion_ = medianMotion(motion_x_, motion_y_);
   motion_x_.clear();  // (now the distances from the median motion)
   for (const cv::Point2f& d : sample_motion_)
@@ -281,7 +284,7 @@ int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyra
   const size_t q = motion_x_.size() * 9 / 10;
   std::nth_element(motion_x_.begin(), motion_x_.begin() + q, motion_x_.end());
   const double needed = 2.0 * motion_x_[q] + 1.0;
-  const int half = params_.window_size_px / 2;  // (the window's side is odd)
+  const int half = params_.window_size_px / 2;  // (rounded down for an even side)
   for (int level = kShortCheckLevel; level < max_level; ++level) {
     if (half * ((2 << level) - 1) >= needed) return level;
   }

@@ -450,14 +450,17 @@ TEST(FeatureTracker, PredictedMotionTracksOnFewerLevelsAsWellAsTheFullPyramid) {
     return runOnViews(tracker, texture(), translations(40, kCentred, {6.0, -2.5}, 0.002), kView);
   };
   const auto predicted = run(true), full = run(false);
-  int short_images = 0, tracked_predicted = 0, tracked_full = 0;
+  int short_images = 0, tracked_predicted = 0, tracked_full = 0, retried = 0;
   for (size_t k = 1; k < full.stats.size(); ++k) {
     EXPECT_EQ(full.stats[k].lk_levels, 5) << "image " << k;
     short_images += predicted.stats[k].lk_levels <= 2;
     tracked_predicted += predicted.stats[k].tracked;
     tracked_full += full.stats[k].tracked;
+    retried += predicted.stats[k].lk_retried;
   }
   EXPECT_GE(short_images, 38);
+  // The short pass itself follows them (started anywhere else they would all be retried).
+  EXPECT_LT(retried, tracked_predicted / 50);
   EXPECT_GE(tracked_predicted, tracked_full * 99 / 100);
   ASSERT_GT(predicted.score.errors().size(), 3000u);
   EXPECT_LT(predicted.score.meanError(), 0.2);
@@ -481,6 +484,7 @@ TEST(FeatureTracker, AJoltIsMeasuredNotPredicted) {
   const auto predicted = run(true), full = run(false);
   const size_t jolt = 12;
   EXPECT_LE(predicted.stats[jolt].lk_levels, 2);
+  EXPECT_LT(predicted.stats[jolt].lk_retried, predicted.stats[jolt].tracked / 10);
   EXPECT_GE(predicted.stats[jolt].tracked, full.stats[jolt].tracked * 98 / 100);
   EXPECT_GE(predicted.stats[jolt].tracked, 100);
   ASSERT_GT(predicted.score.errors().size(), 1500u);
@@ -501,7 +505,8 @@ TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
     tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
     const std::vector<TrackedPoint> first = tracker.current();
     cv::Mat second = warpView(texture(), similarity(0, {}, kCentred + image_step), kView);
-    warpView(texture(), similarity(0, {}, kCentred + patch_step), kView)(patch).copyTo(second(patch));
+    const cv::Mat moved = warpView(texture(), similarity(0, {}, kCentred + patch_step), kView);
+    moved(patch).copyTo(second(patch));
     tracker.process(second);
     int inside = 0, followed = 0, right = 0;
     for (const auto& p : first) {
@@ -515,8 +520,9 @@ TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
         right += cv::norm(q.uv - to) < 0.3;
       }
     }
-    return std::array<int, 5>{inside, followed, right, tracker.lastStats().lk_levels,
-                              tracker.lastStats().lk_retried};
+    return std::array<int, 6>{inside, followed, right, tracker.lastStats().lk_levels,
+                              tracker.lastStats().lk_retried,
+                              static_cast<int>(tracker.previous().size())};
   };
   const auto predicted = run(true), full = run(false);
   ASSERT_GE(full[0], 5);
@@ -525,6 +531,53 @@ TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
   // (At most one of them is in the sample, which had the full pass already: with two
   // the sample's spread would have asked for the full pyramid for all.)
   EXPECT_GE(predicted[4], predicted[0] - 1) << "they were retried";
+  // ... and few others (those at the patch's border, whose window changed).
+  EXPECT_LT(predicted[4], predicted[5] / 4) << "of " << predicted[5];
   EXPECT_EQ(predicted[1], predicted[0]);
   EXPECT_EQ(predicted[2], predicted[0]);
+}
+
+// predict_motion falls back to the full pyramid for all points, exactly as without it,
+// when there are too few points to measure the image's motion (fewer than 36) or the
+// pyramid has no levels to leave out.
+TEST(FeatureTracker, PredictedMotionFallsBackToTheFullPyramidExactly) {
+  auto run = [](bool predict, int features, int levels) {
+    TrackerParams params;
+    params.max_features = features;
+    params.pyramid_levels = levels;
+    params.predict_motion = predict;
+    FeatureTracker tracker(params);
+    return runOnViews(tracker, texture(), translations(15, kCentred, {3.0, -1.5}, 0.002), kView);
+  };
+  for (const auto& [features, levels] : {std::pair{30, 5}, std::pair{150, 2}}) {
+    const auto predicted = run(true, features, levels), full = run(false, features, levels);
+    ASSERT_EQ(predicted.states.size(), full.states.size());
+    for (size_t k = 0; k < full.states.size(); ++k) {
+      EXPECT_EQ(predicted.stats[k].lk_levels, full.stats[k].lk_levels) << "image " << k;
+      ASSERT_EQ(predicted.states[k].size(), full.states[k].size()) << "image " << k;
+      for (size_t i = 0; i < full.states[k].size(); ++i) {
+        EXPECT_EQ(predicted.states[k][i].id, full.states[k][i].id);
+        EXPECT_EQ(predicted.states[k][i].uv, full.states[k][i].uv);
+      }
+    }
+  }
+}
+
+// predict_motion without the forward-backward check: the short pass's results stand, as
+// exact as the full pyramid's without the check.
+TEST(FeatureTracker, PredictedMotionWithoutTheCheckTracksAsExactly) {
+  auto run = [](bool predict) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.predict_motion = predict;
+    params.forward_backward_check = false;
+    FeatureTracker tracker(params);
+    return runOnViews(tracker, texture(), translations(30, kCentred, {5.0, 2.0}, 0.002), kView);
+  };
+  const auto predicted = run(true), full = run(false);
+  EXPECT_LE(predicted.stats.back().lk_levels, 2);
+  ASSERT_GT(predicted.score.errors().size(), 2500u);
+  EXPECT_LT(predicted.score.meanError(), full.score.meanError() + 0.01)
+      << "full pyramid " << full.score.meanError();
+  EXPECT_GE(predicted.score.errors().size(), full.score.errors().size() * 99 / 100);
 }

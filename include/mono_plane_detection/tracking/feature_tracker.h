@@ -43,10 +43,10 @@ struct TrackerParams {
   double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
   // Beyond the paper: measure the image's motion by the full pyramid on a sample of the
   // points, start the others from it on only the pyramid levels the sample's spread
-  // needs; points that pass does not keep get the full pyramid from their old position.
-  // Off by default: 7-31 % less time on images without a search and more points kept,
-  // but the mean error on the EuRoC rows 1-4 % higher and the furnished room's planes a
-  // little off (docs/benchmarks.md, eighth round).
+  // needs; the points this short pass loses get the full pyramid from their old position.
+  // Off by default: 7-33 % less time on images without a search, but the mean error on
+  // the EuRoC rows 0.4-5 % higher, and the furnished room lost its left wall on one run
+  // and its floor on one of five noise seeds (docs/benchmarks.md, eighth round).
   bool predict_motion = false;
 
   // When to search again (paper II-C).
