@@ -439,17 +439,28 @@ TEST(FeatureTracker, SearchSpreadsOverBandsOfSuccessiveImages) {
   EXPECT_EQ(parts_seen[0], 0);
 }
 
+namespace {
+
+// 150 corners, with or without predict_motion.
+TrackerParams predicting(bool predict_motion) {
+  TrackerParams params;
+  params.max_features = 150;
+  params.predict_motion = predict_motion;
+  return params;
+}
+
+GroundTruthRun trackViews(const TrackerParams& params, const std::vector<cv::Matx33d>& hs) {
+  FeatureTracker tracker(params);
+  return runOnViews(tracker, texture(), hs, kView);
+}
+
+}  // namespace
+
 // predict_motion: the image's motion measured on a sample, the other points start from
 // it on fewer pyramid levels, and follow as many points as the full pyramid, as exactly.
 TEST(FeatureTracker, PredictedMotionTracksOnFewerLevelsAsWellAsTheFullPyramid) {
-  auto run = [](bool predict) {
-    TrackerParams params;
-    params.max_features = 150;
-    params.predict_motion = predict;
-    FeatureTracker tracker(params);
-    return runOnViews(tracker, texture(), translations(40, kCentred, {6.0, -2.5}, 0.002), kView);
-  };
-  const auto predicted = run(true), full = run(false);
+  const auto hs = translations(40, kCentred, {6.0, -2.5}, 0.002);
+  const auto predicted = trackViews(predicting(true), hs), full = trackViews(predicting(false), hs);
   int short_images = 0, tracked_predicted = 0, tracked_full = 0, retried = 0;
   for (size_t k = 1; k < full.stats.size(); ++k) {
     EXPECT_EQ(full.stats[k].lk_levels, 5) << "image " << k;
@@ -474,14 +485,7 @@ TEST(FeatureTracker, AJoltIsMeasuredNotPredicted) {
   std::vector<cv::Matx33d> hs = translations(12, kCentred, {2.0, 1.0});
   const cv::Point2d jolted = kCentred + cv::Point2d(11 * 2.0 + 40.0, 11 * 1.0 - 10.0);
   for (int k = 0; k < 6; ++k) hs.push_back(similarity(0, {}, jolted + k * cv::Point2d(2.0, 1.0)));
-  auto run = [&](bool predict) {
-    TrackerParams params;
-    params.max_features = 150;
-    params.predict_motion = predict;
-    FeatureTracker tracker(params);
-    return runOnViews(tracker, texture(), hs, kView);
-  };
-  const auto predicted = run(true), full = run(false);
+  const auto predicted = trackViews(predicting(true), hs), full = trackViews(predicting(false), hs);
   const size_t jolt = 12;
   EXPECT_LE(predicted.stats[jolt].lk_levels, 2);
   EXPECT_LT(predicted.stats[jolt].lk_retried, predicted.stats[jolt].tracked / 10);
@@ -498,10 +502,7 @@ TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
   const cv::Rect patch(380, 60, 170, 170);
   const cv::Point2d image_step(3, 2), patch_step(23, 12);
   auto run = [&](bool predict) {
-    TrackerParams params;
-    params.max_features = 150;
-    params.predict_motion = predict;
-    FeatureTracker tracker(params);
+    FeatureTracker tracker(predicting(predict));
     tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
     const std::vector<TrackedPoint> first = tracker.current();
     cv::Mat second = warpView(texture(), similarity(0, {}, kCentred + image_step), kView);
@@ -542,12 +543,10 @@ TEST(FeatureTracker, PointsMovingUnlikeTheImageGetTheFullPyramid) {
 // pyramid has no levels to leave out.
 TEST(FeatureTracker, PredictedMotionFallsBackToTheFullPyramidExactly) {
   auto run = [](bool predict, int features, int levels) {
-    TrackerParams params;
+    TrackerParams params = predicting(predict);
     params.max_features = features;
     params.pyramid_levels = levels;
-    params.predict_motion = predict;
-    FeatureTracker tracker(params);
-    return runOnViews(tracker, texture(), translations(15, kCentred, {3.0, -1.5}, 0.002), kView);
+    return trackViews(params, translations(15, kCentred, {3.0, -1.5}, 0.002));
   };
   for (const auto& [features, levels] : {std::pair{30, 5}, std::pair{150, 2}}) {
     const auto predicted = run(true, features, levels), full = run(false, features, levels);
@@ -567,12 +566,9 @@ TEST(FeatureTracker, PredictedMotionFallsBackToTheFullPyramidExactly) {
 // exact as the full pyramid's without the check.
 TEST(FeatureTracker, PredictedMotionWithoutTheCheckTracksAsExactly) {
   auto run = [](bool predict) {
-    TrackerParams params;
-    params.max_features = 150;
-    params.predict_motion = predict;
+    TrackerParams params = predicting(predict);
     params.forward_backward_check = false;
-    FeatureTracker tracker(params);
-    return runOnViews(tracker, texture(), translations(30, kCentred, {5.0, 2.0}, 0.002), kView);
+    return trackViews(params, translations(30, kCentred, {5.0, 2.0}, 0.002));
   };
   const auto predicted = run(true), full = run(false);
   EXPECT_LE(predicted.stats.back().lk_levels, 2);
