@@ -32,6 +32,15 @@ cv::Point2f medianMotion(std::vector<float>& dx, std::vector<float>& dy) {
   return {dx[mid], dy[mid]};
 }
 
+// Lucas-Kanade's window and termination, the same for every pass.
+cv::Size lkWindow(const TrackerParams& params) {
+  return {params.window_size_px, params.window_size_px};
+}
+cv::TermCriteria lkCriteria(const TrackerParams& params) {
+  return {cv::TermCriteria::COUNT | cv::TermCriteria::EPS, params.max_iterations,
+          params.epsilon_px};
+}
+
 bool inside(const cv::Point2f& p, const cv::Size& size) {
   return p.x >= 0.f && p.y >= 0.f && p.x <= size.width - 1.f && p.y <= size.height - 1.f;
 }
@@ -106,10 +115,9 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   image_size_ = gray.size();
   stats_ = TrackerFrameStats();
 
-  const cv::Size window(params_.window_size_px, params_.window_size_px);
   // Built into the buffer of the image before last: same sizes, so no new memory.
   std::vector<cv::Mat>& pyramid = pyramids_[pyramid_now_];
-  levels_built_ = cv::buildOpticalFlowPyramid(gray, pyramid, window,
+  levels_built_ = cv::buildOpticalFlowPyramid(gray, pyramid, lkWindow(params_),
                                               std::max(0, params_.pyramid_levels - 1));
 
   std::swap(previous_, current_);  // (swap, not move: both keep their capacity)
@@ -187,15 +195,12 @@ int FeatureTracker::movePoints(const std::vector<std::uint64_t>& ids,
 void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyramid,
                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
   if (previous_.empty()) return;
-  const cv::Size window(params_.window_size_px, params_.window_size_px);
-  const int max_level = std::max(0, params_.pyramid_levels - 1);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                  params_.max_iterations, params_.epsilon_px);
+  const cv::Size window = lkWindow(params_);
+  const cv::TermCriteria criteria = lkCriteria(params_);
   const std::vector<cv::Point2f>& before = positionsOf(previous_, before_);
-  const int full_level = std::min(max_level, levels_built_);
   const int level = params_.predict_motion ? measureImageMotion(previous_pyramid, pyramid, size)
-                                           : full_level;
-  const bool predicted = level < full_level;
+                                           : fullLevel();
+  const bool predicted = level < fullLevel();
   if (predicted) {
     // The sample keeps its own full-pass results (recheck_*_ from measureImageMotion).
     after_.resize(before.size());
@@ -209,7 +214,7 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
     }
   } else {
     cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, before, after_, status_, error_, window,
-                             max_level, criteria, 0, params_.min_eigen_threshold);
+                             fullLevel(), criteria, 0, params_.min_eigen_threshold);
   }
   if (params_.forward_backward_check) checkBackward(previous_pyramid, pyramid);
   if (predicted) retryOnFullPyramid(previous_pyramid, pyramid, size);
@@ -251,8 +256,7 @@ bool FeatureTracker::followed(size_t i, const cv::Size& size) const {
 // few of the sample followed, to measure it.
 int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyramid,
                                        const std::vector<cv::Mat>& pyramid, const cv::Size& size) {
-  // (The pyramid of a small image has fewer levels than asked for.)
-  const int max_level = std::min(std::max(0, params_.pyramid_levels - 1), levels_built_);
+  const int max_level = fullLevel();
   recheck_index_.clear();
   const size_t n = before_.size();
   if (n < 3 * kMotionSample || max_level <= kShortCheckLevel) return max_level;
@@ -261,11 +265,9 @@ int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyra
     recheck_index_.push_back(static_cast<int>(k * n / kMotionSample));
     recheck_from_.push_back(before_[recheck_index_.back()]);
   }
-  const cv::Size window(params_.window_size_px, params_.window_size_px);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                  params_.max_iterations, params_.epsilon_px);
   cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_,
-                           error_, window, max_level, criteria, 0, params_.min_eigen_threshold);
+                           error_, lkWindow(params_), max_level, lkCriteria(params_), 0,
+                           params_.min_eigen_threshold);
   motion_x_.clear();
   motion_y_.clear();
   for (size_t k = 0; k < kMotionSample; ++k) {
@@ -274,13 +276,13 @@ int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyra
     motion_y_.push_back(recheck_to_[k].y - recheck_from_[k].y);
   }
   if (motion_x_.size() < kMotionSample / 2) return max_level;
-  sample_motion_.clear();
-  for (size_t k = 0; k < motion_x_.size(); ++k)
-    sample_motion_.emplace_back(motion_x_[k], motion_y_[k]);
   image_motion_ = medianMotion(motion_x_, motion_y_);
-  motion_x_.clear();  // (now the distances from the median motion)
-  for (const cv::Point2f& d : sample_motion_)
-    motion_x_.push_back(std::hypot(d.x - image_motion_.x, d.y - image_motion_.y));
+  motion_x_.clear();  // (now the followed sample's distances from the median motion)
+  for (size_t k = 0; k < kMotionSample; ++k) {
+    if (!recheck_status_[k] || !inside(recheck_to_[k], size)) continue;
+    const cv::Point2f off = recheck_to_[k] - recheck_from_[k] - image_motion_;
+    motion_x_.push_back(std::hypot(off.x, off.y));
+  }
   const size_t q = motion_x_.size() * 9 / 10;
   std::nth_element(motion_x_.begin(), motion_x_.begin() + q, motion_x_.end());
   const double needed = 2.0 * motion_x_[q] + 1.0;
@@ -304,10 +306,9 @@ void FeatureTracker::retryOnFullPyramid(const std::vector<cv::Mat>& previous_pyr
   }
   stats_.lk_retried = static_cast<int>(recheck_index_.size());
   if (recheck_index_.empty()) return;
-  const cv::Size window(params_.window_size_px, params_.window_size_px);
-  const int max_level = std::max(0, params_.pyramid_levels - 1);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                  params_.max_iterations, params_.epsilon_px);
+  const cv::Size window = lkWindow(params_);
+  const int max_level = fullLevel();
+  const cv::TermCriteria criteria = lkCriteria(params_);
   cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_,
                            error_, window, max_level, criteria, 0, params_.min_eigen_threshold);
   if (params_.forward_backward_check) {
@@ -339,9 +340,8 @@ void FeatureTracker::checkBackward(const std::vector<cv::Mat>& previous_pyramid,
                                    const std::vector<cv::Mat>& pyramid) {
   const std::vector<cv::Point2f>& before = before_;
   const std::vector<cv::Point2f>& after = after_;
-  const cv::Size window(params_.window_size_px, params_.window_size_px);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                  params_.max_iterations, params_.epsilon_px);
+  const cv::Size window = lkWindow(params_);
+  const cv::TermCriteria criteria = lkCriteria(params_);
   motion_x_.clear();
   motion_y_.clear();
   for (size_t i = 0; i < before.size(); ++i) {
@@ -352,28 +352,27 @@ void FeatureTracker::checkBackward(const std::vector<cv::Mat>& previous_pyramid,
   const cv::Point2f motion = medianMotion(motion_x_, motion_y_);
   back_.resize(after.size());
   for (size_t i = 0; i < after.size(); ++i) back_[i] = after[i] - motion;
-  const int short_level = std::min(kShortCheckLevel, std::max(0, params_.pyramid_levels - 1));
+  const int short_level = std::min(kShortCheckLevel, fullLevel());
   cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, after, back_, back_status_, error_, window,
                            short_level, criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
                            params_.min_eigen_threshold);
   back_status_.resize(before.size(), 0);
 
   // The full pass for the forward-tracked points the short one did not bring back.
-  const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
+  const cv::Size size = pyramid[0].size();
   recheck_index_.clear();
   recheck_from_.clear();
   for (size_t i = 0; i < before.size(); ++i) {
-    if (!status_[i] || !inside(after[i], pyramid[0].size())) continue;  // lost either way
-    const cv::Point2f d = back_[i] - before[i];
-    if (back_status_[i] && d.dot(d) <= fb_max2) continue;
+    if (!status_[i] || !inside(after[i], size)) continue;  // lost either way
+    if (followed(i, size)) continue;
     recheck_index_.push_back(static_cast<int>(i));
     recheck_from_.push_back(after[i]);
   }
   if (recheck_index_.empty()) return;
   recheck_back_ = recheck_from_;
   cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, recheck_from_, recheck_back_,
-                           recheck_status_, error_, window, std::max(0, params_.pyramid_levels - 1),
-                           criteria, cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
+                           recheck_status_, error_, window, fullLevel(), criteria,
+                           cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
   for (size_t k = 0; k < recheck_index_.size(); ++k) {
     back_[recheck_index_[k]] = recheck_back_[k];
     back_status_[recheck_index_[k]] = recheck_status_[k];

@@ -3,6 +3,7 @@
 // corners to old points so that tracks keep their ids. ROS-free.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -37,7 +38,8 @@ struct TrackerParams {
 
   // Pyramidal Lucas-Kanade (paper II-C).
   int pyramid_levels = 5;             // levels including full resolution (paper: 5)
-  int window_size_px = 7;             // paper: 3; 7 measured best (docs/benchmarks.md, "LK window size")
+  // LK window side; paper: 3; 7 measured best (docs/benchmarks.md, "LK window size").
+  int window_size_px = 7;
   int max_iterations = 30;            // LK termination: iterations per level
   double epsilon_px = 0.01;           // LK termination: step size
   double min_eigen_threshold = 1e-4;  // LK drops points whose gradient matrix is this flat
@@ -171,6 +173,11 @@ class FeatureTracker {
   bool followed(size_t i, const cv::Size& size) const;
   int measureImageMotion(const std::vector<cv::Mat>& previous_pyramid,
                          const std::vector<cv::Mat>& pyramid, const cv::Size& size);
+  // The top pyramid level Lucas-Kanade can use: pyramid_levels - 1, or fewer when the
+  // image is too small to build them.
+  int fullLevel() const {
+    return std::min(std::max(0, params_.pyramid_levels - 1), levels_built_);
+  }
   void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part);
   template <class InBand>
   void reanchor(const cv::Mat& gray, const InBand& in_band);
@@ -204,7 +211,6 @@ class FeatureTracker {
   std::vector<uchar> recheck_status_, recheck_back_status_;
   std::vector<cv::Point2f> recheck_to_;
   cv::Point2f image_motion_;  // predict_motion: the sample's median motion
-  std::vector<cv::Point2f> sample_motion_;  // predict_motion: the sample's motions
   std::vector<int> described_;  // indices into current_ of the points re-anchored / described
   std::vector<TrackedPoint> fresh_;
   CornerSearchBuffers search_buffers_;
