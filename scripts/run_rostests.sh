@@ -15,7 +15,9 @@ declare -A seconds=([plane_nodelet]=66 [tracker_nodelet]=45 [two_cameras]=32
   [plane_accuracy_humanoid_camera_height]=23 [plane_accuracy_wheeled_auto]=20
   [plane_accuracy_wheeled_camera_height]=20 [plane_accuracy_humanoid_odometry]=19
   [plane_accuracy_wheeled_odometry]=14 [tf_tree]=13 [plane_accuracy_humanoid]=13
-  [plane_accuracy_wheeled]=12 [plane_accuracy_humanoid_aruco]=12
+  [plane_accuracy_furnished_humanoid]=18 [plane_accuracy_furnished_wheeled]=17
+  [plane_accuracy_furnished_wheeled_odometry]=17 [plane_accuracy_wheeled]=12
+  [plane_accuracy_humanoid_aruco]=12
   [plane_accuracy_wheeled_aruco]=12 [tf_localiser]=9 [demo_cli]=6 [sequence_playback]=5)
 ordered=$(for t in $targets; do
   name=${t##*_test_}; name=${name#nodelets_}; name=${name#ros_}; name=${name#tools_}
