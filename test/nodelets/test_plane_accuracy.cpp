@@ -11,11 +11,12 @@
 // ~target_type aruco: the start-up target is the ArUco marker (DICT_4X4_50, id 0, 0.15 m)
 // where the sheet hangs, and both nodelets are told so.
 // ~layout furnished: issue 18's room (furniture, real photographs from test/data/textures,
-// plain painted walls), held to that issue's bounds: normal < 2 deg, distance < 3 % of the
-// camera's distance from the plane where it filled an image most (~max_distance_share, as
-// run_pipeline reports it), camera < 1 % of
-// the path; the planes covering >= 10 % of an image that are missed are printed (the
-// sideboard front and the back wall, docs/mapping.md), those covering >= 15 % asserted.
+// plain painted walls), held to that issue's bounds: normal < 2 deg, camera < 1 % of the
+// path, distance error (the plane's offset at the map's origin, as evaluateMap takes it)
+// < 3 % of the camera's distance from the plane where it filled an image most (as
+// run_pipeline reports it; ~max_distance_share, ~floor_distance_share for the floor); the
+// planes covering >= 10 % of an image that are missed are printed (the sideboard front
+// and the back wall, docs/mapping.md), those covering >= 15 % asserted.
 // camera_height is held to the issue's bounds: normal < 3 deg, distance < 5 % of the
 // plane's distance from the first camera, camera < 5 % of the path (held on every
 // image-noise seed that starts); its map up < 3 deg as every source's. The humanoid's
@@ -55,9 +56,11 @@ std::string g_trajectory = "wheeled";
 std::string g_metric_source = "target";
 std::string g_target_type = "sheet";  // ~target_type: sheet | aruco (the start-up target)
 std::string g_layout = "bare";        // ~layout: bare | furnished (issue 18's room, real photos)
-// ~max_distance_share (furnished): a plane's distance error over the camera's distance from
-// it where it filled an image most; the issue's 3 % unless the .test file says why not.
+// ~max_distance_share, ~floor_distance_share (furnished only): a plane's distance error
+// over the camera's distance from it where it filled an image most; the issue's 3 % unless
+// the .test file says why not (the floor's bound defaults to the others').
 double g_max_distance_share = 0.03;
+double g_floor_distance_share = -1;  // < 0: g_max_distance_share
 
 TEST(PlaneAccuracy, RenderedSequence) {
   SequenceSpec spec;
@@ -240,9 +243,9 @@ TEST(PlaneAccuracy, RenderedSequence) {
   std::printf("  image_planes: %d messages, %d with planes\n", image_plane_messages,
               with_image_planes);
   if (furnished) {
-    // Issue 18's targets, reported: planes covering >= 10 % of an image missed (the
-    // sideboard front and back wall are, docs/mapping.md), each plane's distance error
-    // relative to the first camera's distance from it.
+    // Issue 18's targets: planes covering >= 10 % of an image missed, printed (the
+    // sideboard front and back wall are, docs/mapping.md); each mapped plane's distance
+    // error relative to the camera's distance from it where it filled an image most.
     const MapEvaluation at10 = evaluateMap(mapped, truth_planes, 0.10);
     for (int id : at10.missed)
       for (const TruthPlane& t : truth_planes)
@@ -251,11 +254,14 @@ TEST(PlaneAccuracy, RenderedSequence) {
                       100 * t.max_image_share);
     for (size_t i = 0; i < mapped.size(); ++i)
       for (const TruthPlane& t : truth_planes)
-        if (t.id == e.matches[i].truth_id && range_m.count(t.id)) {
+        if (t.id == e.matches[i].truth_id) {
+          // A plane mapped is one seen: it has a range (0 would divide below).
+          ASSERT_GT(range_m[t.id], 0.0) << t.name << " never in view";
           const double relative = e.matches[i].distance_error_m / range_m[t.id];
           std::printf("  plane %d: distance error %.1f %% of %.2f m\n", mapped[i].id,
                       100 * relative, range_m[t.id]);
-          EXPECT_LT(relative, g_max_distance_share) << t.name;
+          const bool floor = t.name == "floor" && g_floor_distance_share >= 0;
+          EXPECT_LT(relative, floor ? g_floor_distance_share : g_max_distance_share) << t.name;
         }
     EXPECT_LT(e.worst_normal_error_deg, 2.0);  // the issue's bound
     EXPECT_LT(worst, 0.01 * truth.travelled_m);
@@ -325,5 +331,6 @@ int main(int argc, char** argv) {
   pnh.param<std::string>("target_type", g_target_type, g_target_type);
   pnh.param<std::string>("layout", g_layout, g_layout);
   pnh.param("max_distance_share", g_max_distance_share, g_max_distance_share);
+  pnh.param("floor_distance_share", g_floor_distance_share, g_floor_distance_share);
   return RUN_ALL_TESTS();
 }
