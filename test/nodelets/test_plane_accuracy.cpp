@@ -12,7 +12,8 @@
 // where the sheet hangs, and both nodelets are told so.
 // ~layout furnished: issue 18's room (furniture, real photographs from test/data/textures,
 // plain painted walls), held to that issue's bounds: normal < 2 deg, camera < 1 % of the
-// path, distance error (the plane's offset at the map's origin, as evaluateMap takes it)
+// path, distance error (the plane's offset at the map's origin as evaluateMap takes it, or
+// at the first camera without a target, below)
 // < 3 % of the camera's distance from the plane where it filled an image most (as
 // run_pipeline reports it; ~max_distance_share, ~floor_distance_share for the floor); the
 // planes covering >= 10 % of an image that are missed are printed (the sideboard front
