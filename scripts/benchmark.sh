@@ -37,6 +37,11 @@ echo "== tracker against the floor (glibc malloc defaults)"
 rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor.png"
 echo
+echo "== the same with the allocator settings plane_detection.launch sets (what the nodelets get)"
+MALLOC_MMAP_THRESHOLD_=67108864 MALLOC_TRIM_THRESHOLD_=268435456 \
+  rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
+  --plot "$results/benchmark_tracker_floor_launch_malloc.png"
+echo
 echo "== the same with predict_motion (off by default: docs/benchmarks.md, eighth round)"
 rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" --predict-motion 1 \
   --plot "$results/benchmark_tracker_floor_predict_motion.png"
