@@ -12,12 +12,12 @@ results=$1
 data=${2:-$(cd "$(dirname "$0")/.." && pwd)/../shared/data}
 mkdir -p "$results"
 # Both allocator settings: glibc's defaults, and the ones plane_detection.launch sets.
+launch_malloc=(MALLOC_MMAP_THRESHOLD_=67108864 MALLOC_TRIM_THRESHOLD_=268435456)
 echo "== glibc malloc defaults"
 rosrun mono_plane_detection benchmark_suite --plot "$results/benchmark_default_malloc.png"
 echo
 echo "== MALLOC_MMAP_THRESHOLD_=64 MiB, MALLOC_TRIM_THRESHOLD_=256 MiB (as plane_detection.launch)"
-MALLOC_MMAP_THRESHOLD_=67108864 MALLOC_TRIM_THRESHOLD_=268435456 \
-  rosrun mono_plane_detection benchmark_suite --plot "$results/benchmark.png"
+env "${launch_malloc[@]}" rosrun mono_plane_detection benchmark_suite --plot "$results/benchmark.png"
 echo
 # Real textures: the first EuRoC left image and the first TUM office frame, when there.
 real=()
@@ -38,8 +38,7 @@ rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor.png"
 echo
 echo "== the same with the allocator settings plane_detection.launch sets (what the nodelets get)"
-MALLOC_MMAP_THRESHOLD_=67108864 MALLOC_TRIM_THRESHOLD_=268435456 \
-  rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
+env "${launch_malloc[@]}" rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor_launch_malloc.png"
 echo
 echo "== the same with predict_motion (off by default: docs/benchmarks.md, eighth round)"

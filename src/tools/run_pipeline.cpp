@@ -119,7 +119,6 @@ int main(int argc, char** argv) {
   const IndoorScene scene = makeRoom(room);
   const SceneRenderer renderer(scene, camera, render);
   std::vector<TruthPlane> truth = truthPlanes(scene);
-  std::vector<double> range(truth.size(), 1.0);
   const Pose map_from_world = scene.target.world_from_map.inverse();
 
   // The nodelets' settings for this robot, so that a run here is a run there.
@@ -173,10 +172,8 @@ int main(int argc, char** argv) {
         for (size_t p = 0; p < truth.size(); ++p)
           if (shares[p] > truth[p].max_image_share) {
             truth[p].max_image_share = shares[p];
-            // Relative distance errors are judged against the camera's distance from
-            // the plane where it filled the image most.
-            range[p] = std::abs(scene.planes[p].normal().dot(world_from_camera.t) -
-                                scene.planes[p].distance());
+            truth[p].range_m = std::abs(scene.planes[p].normal().dot(world_from_camera.t) -
+                                        scene.planes[p].distance());
           }
       }
       const cv::Mat image = renderer.render(world_from_camera,
@@ -287,7 +284,7 @@ int main(int argc, char** argv) {
       }
       for (size_t t = 0; t < judged.size(); ++t) {
         judged[t].distance += judged[t].normal.dot(shift);
-        range[t] = std::abs(judged[t].distance);
+        judged[t].range_m = std::abs(judged[t].distance);
       }
     }
     const MapEvaluation eval = evaluateMap(confirmed, judged, truth_from_map ? 0.15 : 0.10);
@@ -297,8 +294,8 @@ int main(int argc, char** argv) {
       const MapPlane& p = confirmed[i];
       const PlaneMatch& m = eval.matches[i];
       double relative = 0;
-      for (size_t t = 0; t < truth.size(); ++t)
-        if (truth[t].id == m.truth_id) relative = m.distance_error_m / range[t];
+      for (const TruthPlane& t : judged)
+        if (t.id == m.truth_id && t.range_m > 0) relative = m.distance_error_m / t.range_m;
       std::printf(
           "  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
           "(normal %.2f deg, distance %.3f m = %.1f %%)\n",

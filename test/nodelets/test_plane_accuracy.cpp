@@ -43,8 +43,6 @@
 #include "mono_plane_detection/eval/map_evaluation.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
-#include "mono_plane_detection/sim/camera_trajectory.h"
-#include "mono_plane_detection/sim/indoor_scene.h"
 #include "support/diagnostics_probe.h"
 #include "support/test_timeouts.h"
 #include "support/temp_path.h"
@@ -203,24 +201,6 @@ TEST(PlaneAccuracy, RenderedSequence) {
         position_errors[i] = cv::norm(truth_from_map.apply(est_path[i]) - true_path[i]);
   }
   std::vector<TruthPlane> truth_planes = truth.planes;
-  // Furnished: each true plane's distance from the camera where it filled an image most
-  // (run_pipeline's reference for a relative distance error), by plane id.
-  std::map<int, double> range_m;
-  if (furnished) {
-    const IndoorScene scene = makeRoom(spec.room);
-    std::map<int, double> share;
-    for (int k = 0; k < spec.frames; ++k) {
-      const Pose world_from_camera = trajectoryPose(spec.trajectory, k / spec.fps);
-      const std::vector<double> shares = imageShares(scene, spec.camera, world_from_camera, 16);
-      for (size_t p = 0; p < shares.size(); ++p) {
-        const ScenePlane& plane = scene.planes[p];
-        if (shares[p] <= share[plane.id]) continue;
-        share[plane.id] = shares[p];
-        range_m[plane.id] =
-            std::abs(plane.normal().dot(world_from_camera.t) - plane.distance());
-      }
-    }
-  }
   if (!with_target && !true_path.empty()) {
     // Without the target its frame (the truth's) has its origin 20 m up, where a plane
     // distance error mostly measures the normal's error times 20 m: judge distances from
@@ -257,10 +237,10 @@ TEST(PlaneAccuracy, RenderedSequence) {
       for (const TruthPlane& t : truth_planes)
         if (t.id == e.matches[i].truth_id) {
           // A plane mapped is one seen: it has a range (0 would divide below).
-          ASSERT_GT(range_m[t.id], 0.0) << t.name << " never in view";
-          const double relative = e.matches[i].distance_error_m / range_m[t.id];
+          ASSERT_GT(t.range_m, 0.0) << t.name << " never in view";
+          const double relative = e.matches[i].distance_error_m / t.range_m;
           std::printf("  plane %d: distance error %.1f %% of %.2f m\n", mapped[i].id,
-                      100 * relative, range_m[t.id]);
+                      100 * relative, t.range_m);
           const bool floor = t.name == "floor" && g_floor_distance_share >= 0;
           EXPECT_LT(relative, floor ? g_floor_distance_share : g_max_distance_share) << t.name;
         }

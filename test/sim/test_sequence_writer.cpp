@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "../../src/sim/bag/ground_truth.h"
 #include "../../src/sim/bag/sequence_writer.h"
 #include "support/temp_path.h"
 
@@ -108,6 +109,22 @@ TEST(SequenceWriter, GroundTruthYamlDescribesTheScene) {
   const auto start = gt["camera_gt_in_map"][0]["position"].as<std::vector<double>>();
   EXPECT_NEAR(start[2], 2.0, 1e-9);
   EXPECT_NEAR(start[1], 0.4, 0.03);
+  // Each plane in view: the camera's distance from it where it covered the most of an
+  // image (the reference of relative distance errors), read back by loadGroundTruth.
+  const GroundTruth truth = loadGroundTruth(temp("gt.yaml"));
+  ASSERT_EQ(truth.planes.size(), 6u);
+  for (const TruthPlane& t : truth.planes) {
+    if (t.max_image_share <= 0) continue;
+    double nearest = 1e9, farthest = 0;  // over the images: the range is one of them
+    for (const Pose& pose : truth.poses) {
+      const double d = std::abs(t.normal.dot(pose.t) - t.distance);
+      nearest = std::min(nearest, d);
+      farthest = std::max(farthest, d);
+    }
+    EXPECT_GE(t.range_m, nearest - 1e-9) << t.name;
+    EXPECT_LE(t.range_m, farthest + 1e-9) << t.name;
+  }
+  EXPECT_NEAR(truth.planes[1].range_m, 2.0, 0.1);  // the front wall, seen from the start
 }
 
 TEST(SequenceWriter, SameSeedSameBytes) {

@@ -19,6 +19,9 @@ struct TruthPlane {
   cv::Vec3d normal;            // unit, map frame, into the room
   double distance = 0;         // m: {x : normal . x = distance}
   double max_image_share = 0;  // largest share of an image it covered (0..1)
+  // The camera's distance from it in that image, m (0: unknown): the reference of a
+  // relative distance error (a plane is judged against how far it was seen from).
+  double range_m = 0;
 };
 
 // The scene's planes in the map (target) frame; max_image_share left 0.

@@ -28,6 +28,7 @@ GroundTruth loadGroundTruth(const std::string& yaml_path) {
       t.normal = vec3(p["normal"]);
       t.distance = p["distance_m"].as<double>();
       t.max_image_share = p["max_image_share"] ? p["max_image_share"].as<double>() : 1.0;
+      t.range_m = p["range_at_max_share_m"] ? p["range_at_max_share_m"].as<double>() : 0.0;
       truth.planes.push_back(t);
     }
     for (const auto& c : root["target"]["corners_map"]) truth.target_corners.push_back(vec3(c));

@@ -99,16 +99,22 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
   root["target"] = target;
   // How much of some image each plane covers: the accuracy tests require the planes
   // that cover at least 10 % of an image.
-  std::vector<double> max_share(scene.planes.size(), 0.0);
+  std::vector<double> max_share(scene.planes.size(), 0.0), range(scene.planes.size(), 0.0);
   for (int k = 0; k < spec.frames; ++k) {
     const Pose world_from_camera = trajectoryPose(spec.trajectory, k / spec.fps);
     const std::vector<double> shares = imageShares(scene, spec.camera, world_from_camera, 16);
-    for (size_t i = 0; i < shares.size(); ++i) max_share[i] = std::max(max_share[i], shares[i]);
+    for (size_t i = 0; i < shares.size(); ++i) {
+      if (shares[i] <= max_share[i]) continue;
+      max_share[i] = shares[i];
+      range[i] = std::abs(scene.planes[i].normal().dot(world_from_camera.t) -
+                          scene.planes[i].distance());
+    }
   }
   for (size_t i = 0; i < scene.planes.size(); ++i) {
     const ScenePlane& p = scene.planes[i];
     YAML::Node plane;
     plane["max_image_share"] = max_share[i];
+    plane["range_at_max_share_m"] = range[i];
     plane["id"] = p.id;
     plane["name"] = p.name;
     plane["surface"] = p.surface;
