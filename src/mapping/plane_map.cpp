@@ -5,6 +5,7 @@
 #include <random>
 
 #include "mono_plane_detection/geometry/plane_fit.h"
+#include "mono_plane_detection/mapping/structure_fit.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -302,7 +303,8 @@ int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double
   }
   // Count the observation only from a new viewpoint: images from one spot repeat the
   // same evidence (and the same mixture, if it is one).
-  const double range = std::max(0.3, std::abs(plane->normal.dot(kept.viewpoint) - plane->distance));
+  const double range =
+      std::max(0.3, std::abs(plane->own_normal.dot(kept.viewpoint) - plane->own_distance));
   std::vector<cv::Vec3d> seen_from = kept.measured_from;
   seen_from.push_back(kept.viewpoint);
   for (const cv::Vec3d& from : seen_from) {
@@ -347,7 +349,7 @@ int PlaneMap::associate(const cv::Vec3d& normal, double distance,
   return best;
 }
 
-bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
+bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) const {
   // Bound the memory: keep the most recently seen points.
   if (plane.points.size() > params_.max_points_per_plane) {
     std::vector<std::pair<double, std::uint64_t>> by_age;
@@ -377,12 +379,28 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint) const {
       it = plane.points.erase(it);
     }
   }
+  // How well its own points fix the normal decides confirmation, whatever the structure
+  // below adds: a strip is not confirmed by being at right angles to a wall.
+  plane.normal_sigma_deg =
+      std::min(plane.motion_sigma_deg, normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m));
+  std::vector<ReferencePlane> references;
+  for (const MapPlane& other : planes_)
+    if (other.id != plane.id && other.id != merged && other.confirmed(params_) &&
+        other.normal_sigma_deg < plane.normal_sigma_deg)
+      references.push_back({other.normal, other.normal_sigma_deg});
+  plane.own_normal = fit.normal;
+  plane.own_distance = fit.distance;
+  if (!references.empty()) {
+    const StructuredPlane held =
+        structuredPlane(inliers, fit.normal, plane.normal_sigma_deg, references,
+                        params_.structure_sigmas, params_.min_residual_m);
+    fit.normal = held.normal;
+    fit.distance = held.distance;
+  }
   plane.normal = fit.normal;
   plane.distance = fit.distance;
   plane.rms_m = fit.rms_m;
   plane.polygon = planePolygon(fit.normal, fit.distance, inliers);
-  plane.normal_sigma_deg =
-      std::min(plane.motion_sigma_deg, normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m));
   return true;
 }
 
@@ -408,7 +426,7 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
       if (merged.views.size() > 16) merged.views.resize(16);
       merged.first_seen = std::min(a.first_seen, b.first_seen);
       merged.last_seen = std::max(a.last_seen, b.last_seen);
-      if (refit(merged, viewpoint)) {
+      if (refit(merged, viewpoint, b.id)) {
         a = merged;
         planes_.erase(planes_.begin() + static_cast<long>(j));
       } else {

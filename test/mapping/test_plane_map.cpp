@@ -344,3 +344,49 @@ TEST(PlaneMap, APlaneFromMotionCountsItsFitsViewsAndSigma) {
   map.update({observe(kWall, 0.0, 200, 10, 2, 0.15)}, 1000.1);
   EXPECT_LE(map.planes()[0].normal_sigma_deg, 0.8);
 }
+
+// Indoor structure (map/structure_sigmas): a floor seen as a strip 0.2 m wide along a wall
+// (as the humanoid sees it) turns about the strip by its points' noise; once two walls are
+// confirmed it is held at right angles to them, without being confirmed by that (its own
+// points still leave it a strip). With structure_sigmas 0 it keeps its own tilt.
+TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
+  const cv::Vec3d left(1, 0, 0);
+  double held_sum = 0, free_sum = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    MapParams off;
+    off.structure_sigmas = 0;
+    PlaneMap held, alone(off);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> across(-2.9, -2.7), along(0.5, 3.0);
+    std::normal_distribution<double> noise(0, 0.01);
+    for (int k = 0; k < 8; ++k) {
+      PlaneObservation floor;
+      floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
+      for (int i = 0; i < 12; ++i) {
+        floor.ids.push_back(5000 + 12 * k + i);
+        floor.points.push_back({across(rng), -0.8 + noise(rng), along(rng)});
+      }
+      const auto walls = {observe(kWall, 0.0, 100 + 30 * k, 30, seed * 10 + k, 1.5),
+                          observe(left, -3.0, 1000 + 30 * k, 30, seed * 20 + k, 1.5)};
+      std::vector<PlaneObservation> image(walls);
+      if (k >= 4) image.push_back(floor);  // the floor after the walls are confirmed
+      held.update(image, 1000 + 0.1 * k);
+      alone.update(image, 1000 + 0.1 * k);
+    }
+    auto floorOf = [&](const PlaneMap& map) -> const MapPlane* {
+      for (const MapPlane& p : map.planes())
+        if (normalAngleDeg(p.normal, kFloor) < 10) return &p;
+      return nullptr;
+    };
+    const MapPlane* with = floorOf(held);
+    const MapPlane* without = floorOf(alone);
+    ASSERT_TRUE(with && without) << seed;
+    EXPECT_LT(normalAngleDeg(with->normal, kFloor), 0.5) << seed;
+    EXPECT_FALSE(with->confirmed(held.params())) << seed;  // still a strip by its points
+    EXPECT_EQ(with->normal_sigma_deg, without->normal_sigma_deg);
+    EXPECT_EQ(with->observations, without->observations);  // views spaced by its own plane
+    held_sum += normalAngleDeg(with->normal, kFloor);
+    free_sum += normalAngleDeg(without->normal, kFloor);
+  }
+  EXPECT_GT(free_sum / 10, 2 * held_sum / 10);  // the strip alone is worse: a real test
+}

@@ -38,6 +38,10 @@ struct MapParams {
   // And only once its points fix its normal to this (1 sigma, normal_sigma_deg): half the
   // 2 deg a mapped plane may be off. A strip of points leaves the plane free to turn.
   double max_normal_sigma_deg = 1.0;
+  // A plane is held at right angles to (or parallel to) better-known confirmed planes
+  // while its points do not reject that at this many of their standard deviations
+  // (mapping/structure_fit.h); 0: off, each plane fitted alone.
+  double structure_sigmas = 3.0;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -66,6 +70,10 @@ struct MapPlane {
   cv::Vec3d normal{0, 0, 1};       // unit, towards the side it was seen from
   double distance = 0;             // m: the plane is {x : normal . x = distance}
   double rms_m = 0;                // fit over its points
+  // Its points' own plane, before the room's right angles (MapParams::structure_sigmas)
+  // hold it: what the views it counts are spaced by, as its confirmation is its points'.
+  cv::Vec3d own_normal{0, 0, 1};
+  double own_distance = 0;
   // How well its points fix the normal (deg): rms / sqrt(points) against their spread
   // across the plane's long axis.
   double normal_sigma_deg = 180;
@@ -109,7 +117,8 @@ class PlaneMap {
   PlaneFit fitObservation(const PlaneObservation& obs, int needed) const;
   int fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance, double stamp);
   int associate(const cv::Vec3d& normal, double distance, const PlaneObservation& obs) const;
-  bool refit(MapPlane& plane, const cv::Vec3d& viewpoint) const;
+  // `merged`: the id of a plane merged into this one (not a reference for it).
+  bool refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged = -1) const;
   void mergeDuplicates(const cv::Vec3d& viewpoint);
   void fadeAndBound(double stamp);
 
