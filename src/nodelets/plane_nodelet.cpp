@@ -597,10 +597,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool fromBeforeClockJump(const ros::Time& stamp) {
     const ros::Time now = ros::Time::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    if (now < clock_seen_) {
-      jumped_from_ = clock_seen_;
-      clock_went_back_ = true;
-    }
+    if (now < clock_seen_) jumped_from_ = clock_seen_;
     clock_seen_ = now;
     if (jumped_from_.isZero()) return false;
     if (stamp.toSec() > 0.5 * (now.toSec() + jumped_from_.toSec())) return true;
@@ -666,6 +663,9 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
                      info_sub_.getTopic().c_str());
       }
+      // The pause a tracking loss is about (the WARN says it, not the threshold).
+      const double gap_s = previous_stamp_ ? frame.stamp - *previous_stamp_ : 0.0;
+      previous_stamp_ = frame.stamp;
       // The core's axes (y up) for the odometry: with metric_source odometry the ROS map
       // is then the odometry frame itself (docs/ros_interface.md).
       const PipelineResult result =
@@ -690,19 +690,21 @@ class PlaneNodelet : public nodelet::Nodelet {
         mapStartedOver();
         ++resets_;
         ++backwards_resets_;
-        // The listener cleared its buffer when it saw the clock go back, then took in what
-        // was queued before the jump: our own transform of the previous loop's last images
-        // among it (measured: 59 TF_OLD_DATA in a loop of the room bag with the stale
-        // tracks above kept off tf). Cleared again now that the tracks agree (tf2_ros's
-        // own remedy; the static links stay): the new loop's odometry refills it.
-        if (clock_went_back_ && tf_buffer_) tf_buffer_->clear();
+        // Under simulated time the listener cleared its buffer when it saw the clock go
+        // back, then took in what was queued before the jump: our own transform of the
+        // previous loop's last images among it (measured: 59 TF_OLD_DATA in a loop of the
+        // room bag with the stale tracks above kept off tf). Without it (a bag looped on
+        // the wall clock) nothing cleared it, and every transform of the new loop, ours and
+        // the bag's, came again at a stamp it held: tf2 printed TF_REPEATED_DATA for each,
+        // about 570 per 10 s loop. Cleared now that the tracks agree, either way (tf2_ros's
+        // own remedy; the static links stay): the new loop's transforms refill it.
+        if (tf_buffer_) tf_buffer_->clear();
       }
-      if (!before_jump) clock_went_back_ = false;  // (kept over the previous loop's tracks)
       if (result.tracking_loss && logNow("tracking loss", 5.0))
         NODELET_WARN(
-            "%.1f s without tracks: tracking lost, waiting for %s to place the camera "
+            "%.3f s without tracks: tracking lost, waiting for %s to place the camera "
             "again",
-            params_.max_gap_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
+            gap_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
@@ -890,7 +892,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   long backwards_resets_ = 0;           // map resets because time went backwards
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
-  bool clock_went_back_ = false;        // since the last tracks (fromBeforeClockJump)
   RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
   bool reset_markers_ = false;
@@ -900,6 +901,7 @@ class PlaneNodelet : public nodelet::Nodelet {
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
+  std::optional<double> previous_stamp_;  // of the tracks processed last (under mutex_)
   std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
   StretchedWait target_wait_;  // for the metric start, in tracks stamps
   std::optional<Pose> last_odom_;
