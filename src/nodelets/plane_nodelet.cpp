@@ -201,7 +201,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     });
   }
 
-  void onReconfigure(const PlanesConfig& config) {
+  void onReconfigure(PlanesConfig& config) {
     std::lock_guard<std::mutex> lock(mutex_);
     PlaneNodeParams node = node_;
     for (const auto& description : PlanesConfig::__getParamDescriptions__()) {
@@ -220,11 +220,43 @@ class PlaneNodelet : public nodelet::Nodelet {
           },
           spec->field(node));
     }
-    for (const std::string& error : validate(node)) NODELET_ERROR("reconfigure: %s", error.c_str());
+    const std::vector<std::string> errors = validate(node);
+    for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
+    if (!errors.empty()) writeBack(node, config);
     node_ = node;
     params_ = node.pipeline;
     pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
     ++reconfigures_;
+  }
+
+  // The values in use, after validate() repaired what was refused, written back into the
+  // reconfigure's config: the server then reports and stores them (it showed a NaN the
+  // nodelet had replaced by the default).
+  void writeBack(PlaneNodeParams& node, PlanesConfig& config) const {
+    dynamic_reconfigure::Config message;
+    config.__toMessage__(message);
+    auto inUse = [&](const std::string& flat) {
+      const auto it = cfg_names_.find(flat);
+      return it == cfg_names_.end() ? nullptr : findParam(planeNodeParamTable(), it->second);
+    };
+    auto put = [&](auto& parameters) {
+      for (auto& p : parameters) {
+        const auto* spec = inUse(p.name);
+        if (!spec) continue;
+        std::visit(
+            [&](auto* v) {
+              using T = std::remove_pointer_t<decltype(v)>;
+              using Out = decltype(p.value);
+              if constexpr (std::is_same_v<Out, double> ? std::is_same_v<T, double>
+                                                        : std::is_integral_v<T> && !std::is_same_v<T, bool>)
+                p.value = static_cast<Out>(*v);
+            },
+            spec->field(node));
+      }
+    };
+    put(message.doubles);
+    put(message.ints);
+    config.__fromMessage__(message);
   }
 
   void connect() {

@@ -947,6 +947,25 @@ TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
   setMaxPlanes(8);
   EXPECT_GE(planesNow(5.0, 4000), 2u);
   std::printf("image planes: %zu, with planes_max_planes 1: %zu\n", before, capped);
+  // A value the nodelet refuses (NaN) is replaced by the default, and the server reports
+  // the value in use, not the one refused.
+  dynamic_reconfigure::Reconfigure nan_gap;
+  dynamic_reconfigure::DoubleParameter gap;
+  gap.name = "max_gap_s";
+  gap.value = std::numeric_limits<double>::quiet_NaN();
+  nan_gap.request.config.doubles.push_back(gap);
+  EXPECT_TRUE(ros::service::call("/plane_detector/set_parameters", nan_gap));
+  bool reported = false;
+  for (const auto& d : nan_gap.response.config.doubles)
+    if (d.name == "max_gap_s") {
+      reported = true;
+      EXPECT_EQ(d.value, 1.0);  // the default (docs/parameters.md)
+    }
+  EXPECT_TRUE(reported);
+  double stored = 0;
+  EXPECT_TRUE(ros::param::get("/plane_detector/max_gap_s", stored));
+  EXPECT_EQ(stored, 1.0);
+  EXPECT_GE(planesNow(5.5, 4000), 2u);  // and the nodelet goes on
   // The YAML's nested values were the server's start, not the .cfg defaults.
   int max_groups = 0;
   EXPECT_TRUE(ros::param::get("/plane_detector/planes_groups_max_groups", max_groups));
