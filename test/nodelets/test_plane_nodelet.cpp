@@ -1047,6 +1047,35 @@ TEST_F(PlaneNodeletTest, Q_CameraFrameMissingFromTfIsNamed) {
       << other.diagnostics.message();
 }
 
+// A camera_info of another frame than the tracks' (another camera's, through a remap gone
+// wrong) is used all the same but counted and said (a hostile try found it silent).
+TEST_F(PlaneNodeletTest, R_CameraInfoOfAnotherFrameIsCounted) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long before = diagnostics.number("tracks with camera_info of another frame_id (total)");
+  ASSERT_GE(before, 0);
+  sensor_msgs::CameraInfo other = cameraInfo(world_->camera);
+  other.header.frame_id = "left_camera_optical";
+  info_pub_.publish(other);
+  ros::WallDuration(0.3).sleep();
+  for (int k = 0; k < 5; ++k) {
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += 7000;
+    ASSERT_TRUE(send(toTracks(f))) << k;  // frame camera_optical
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("tracks with camera_info of another frame_id (total)") - before, 5);
+  info_pub_.publish(cameraInfo(world_->camera));  // its own again: no more counted
+  ros::WallDuration(0.3).sleep();
+  for (int k = 5; k < 8; ++k) {
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += 7000;
+    ASSERT_TRUE(send(toTracks(f))) << k;
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("tracks with camera_info of another frame_id (total)") - before, 5);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
