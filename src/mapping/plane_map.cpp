@@ -383,17 +383,21 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
   // below adds: a strip is not confirmed by being at right angles to a wall.
   plane.normal_sigma_deg =
       std::min(plane.motion_sigma_deg, normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m));
-  std::vector<ReferencePlane> references;
-  for (const MapPlane& other : planes_)
-    if (other.id != plane.id && other.id != merged && other.confirmed(params_) &&
-        other.normal_sigma_deg < plane.normal_sigma_deg)
-      references.push_back({other.normal, other.normal_sigma_deg});
   plane.own_normal = fit.normal;
   plane.own_distance = fit.distance;
+  // Held only once its own points fix its normal to a map's bound: a loose plane (a few
+  // points, a strip) would swing to a reference by degrees, and out of its observations'
+  // association gate. The references' own planes, not their held ones: none is pulled back
+  // by its own earlier pull through another.
+  std::vector<ReferencePlane> references;
+  if (plane.normal_sigma_deg <= params_.max_normal_sigma_deg)
+    for (const MapPlane& other : planes_)
+      if (other.id != plane.id && other.id != merged && other.confirmed(params_) &&
+          other.normal_sigma_deg < plane.normal_sigma_deg)
+        references.push_back({other.own_normal, other.normal_sigma_deg});
   if (!references.empty()) {
-    const StructuredPlane held =
-        structuredPlane(inliers, fit.normal, plane.normal_sigma_deg, references,
-                        params_.structure_sigmas, params_.min_residual_m);
+    const StructuredPlane held = structuredPlane(inliers, fit.normal, references,
+                                                 params_.structure_sigmas, params_.min_residual_m);
     fit.normal = held.normal;
     fit.distance = held.distance;
   }

@@ -6,9 +6,28 @@
 #include "mono_plane_detection/geometry/plane_fit.h"
 
 namespace mono_plane_detection {
+namespace {
+
+// A relation's information on the normal: a right angle to m, (n . m)^2 / sigma^2; the
+// parallel, |n x m|^2 / sigma^2 (sigma in rad).
+cv::Matx33d relationInformation(const cv::Vec3d& m, bool right_angle, double sigma_deg) {
+  const double sigma = std::max(sigma_deg, 0.01) * CV_PI / 180;
+  const cv::Matx33d along = m * m.t();
+  return (right_angle ? along : cv::Matx33d::eye() - along) * (1 / (sigma * sigma));
+}
+
+// The unit normal minimising n' A n (the smallest eigenvector), on the side of `side`.
+cv::Vec3d smallestDirection(const cv::Matx33d& a, const cv::Vec3d& side) {
+  cv::Mat values, vectors;
+  cv::eigen(cv::Mat(a), values, vectors);  // descending: the last row is the minimum
+  cv::Vec3d n(vectors.at<double>(2, 0), vectors.at<double>(2, 1), vectors.at<double>(2, 2));
+  return n.dot(side) < 0 ? -n : n;
+}
+
+}  // namespace
 
 StructuredPlane structuredPlane(const std::vector<cv::Vec3d>& points,
-                                const cv::Vec3d& free_normal, double normal_sigma_deg,
+                                const cv::Vec3d& free_normal,
                                 const std::vector<ReferencePlane>& references, double sigmas,
                                 double floor_m) {
   StructuredPlane out;
@@ -25,31 +44,35 @@ StructuredPlane structuredPlane(const std::vector<cv::Vec3d>& points,
   const double free_ssr = free_normal.dot(scatter * free_normal);
   const double variance =
       std::max(free_ssr / static_cast<double>(points.size() - 3), floor_m * floor_m);
-  // The points' information on the normal (n' S n / variance: the residuals' chi-square)
-  // plus each relation's: a right angle (n . m)^2 / sigma^2, parallel |n x m|^2 / sigma^2.
-  cv::Matx33d information = scatter * (1.0 / variance);
+  if (!(variance > 0) || !std::isfinite(variance)) return out;
+  // The points' information on the normal: n' S n / variance is their residuals' chi-square.
+  const cv::Matx33d own = scatter * (1.0 / variance);
+  // Whether the points allow this normal: their residuals grow by at most sigmas^2 per
+  // degree of freedom taken.
+  auto allowed = [&](const cv::Vec3d& n, double taken) {
+    const double grown = (n.dot(scatter * n) - free_ssr) / variance;
+    return std::isfinite(grown) && grown <= sigmas * sigmas * taken;
+  };
+  // Each reference on its own: the nearer of its two relations, kept when the points
+  // allow the normal fused with it alone (a relation they deny, a turn about an axis they
+  // fix, does not cancel the others).
+  cv::Matx33d information = own;
+  int taken = 0;
   for (const ReferencePlane& ref : references) {
-    const double angle = normalAngleDeg(free_normal, ref.normal);
-    const double gate = sigmas * std::hypot(normal_sigma_deg, ref.normal_sigma_deg);
-    const double sigma_rad = std::max(ref.normal_sigma_deg, 0.01) * CV_PI / 180;
-    const cv::Matx33d along = ref.normal * ref.normal.t();
-    if (std::abs(angle - 90) <= gate) {
-      information += along * (1 / (sigma_rad * sigma_rad));
-      ++out.perpendicular;
-    } else if (std::min(angle, 180 - angle) <= gate) {
-      information += (cv::Matx33d::eye() - along) * (1 / (sigma_rad * sigma_rad));
-      ++out.parallel;
-    }
+    const double length = cv::norm(ref.normal);
+    if (!(length > 0) || !std::isfinite(ref.normal_sigma_deg)) continue;
+    const cv::Vec3d m = ref.normal * (1 / length);
+    const double angle = normalAngleDeg(free_normal, m);
+    const bool right_angle = std::abs(angle - 90) <= std::min(angle, 180 - angle);
+    const cv::Matx33d relation = relationInformation(m, right_angle, ref.normal_sigma_deg);
+    if (!allowed(smallestDirection(own + relation, free_normal), right_angle ? 1 : 2)) continue;
+    information += relation;
+    taken += right_angle ? 1 : 2;
+    ++(right_angle ? out.perpendicular : out.parallel);
   }
-  if (out.perpendicular + out.parallel == 0) return out;
-  cv::Mat values, vectors;
-  cv::eigen(cv::Mat(information), values, vectors);  // descending: the last is the minimum
-  cv::Vec3d n(vectors.at<double>(2, 0), vectors.at<double>(2, 1), vectors.at<double>(2, 2));
-  if (n.dot(free_normal) < 0) n = -n;
-  // The points must not reject it: their residuals may grow by sigmas^2 per degree of
-  // freedom the relations take (at most the normal's two).
-  const double taken = std::min(2, out.perpendicular + 2 * out.parallel);
-  if ((n.dot(scatter * n) - free_ssr) / variance > sigmas * sigmas * taken) {
+  if (taken == 0) return out;
+  const cv::Vec3d n = smallestDirection(information, free_normal);
+  if (!allowed(n, std::min(taken, 2))) {  // together they ask more than each alone
     out.perpendicular = out.parallel = 0;
     return out;
   }

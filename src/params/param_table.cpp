@@ -355,7 +355,7 @@ const ParamTable<MapParams>& mapParamTable() {
        "and only once its points fix its normal to this (1 sigma)"},
       {"min_gap_m", field(&P::min_gap_m), 0, 100, "m",
        "a plane's points in two groups this far apart, one not that plane alone: refused"},
-      {"structure_sigmas", field(&P::structure_sigmas), 0, 100, "",
+      {"structure_sigmas", field(&P::structure_sigmas), 0, 10, "",
        "a plane is held at right angles to or parallel to better-known confirmed planes "
        "while its points do not reject that at this many standard deviations (0: off)"},
       {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",

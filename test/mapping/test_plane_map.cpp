@@ -1,6 +1,7 @@
 // The map of planes: association, stable ids, merging, fading, bounds.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 
 #include "mono_plane_detection/geometry/plane_fit.h"
@@ -345,10 +346,12 @@ TEST(PlaneMap, APlaneFromMotionCountsItsFitsViewsAndSigma) {
   EXPECT_LE(map.planes()[0].normal_sigma_deg, 0.8);
 }
 
-// Indoor structure (map/structure_sigmas): a floor seen as a strip 0.2 m wide along a wall
-// (as the humanoid sees it) turns about the strip by its points' noise; once two walls are
-// confirmed it is held at right angles to them, without being confirmed by that (its own
-// points still leave it a strip). With structure_sigmas 0 it keeps its own tilt.
+// Indoor structure (map/structure_sigmas): a floor seen as a strip 0.3 m wide along a wall
+// (as the humanoid sees it) turns about the strip by its points' noise (0.6 cm: its
+// normal known to under 1 deg, max_normal_sigma_deg); once two walls are
+// confirmed it is held at right angles to them. Its confirmation and the views it counts
+// stay its own points' (own_normal: the fit without the walls). With structure_sigmas 0 it
+// keeps its own tilt.
 TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
   const cv::Vec3d left(1, 0, 0);
   double held_sum = 0, free_sum = 0;
@@ -357,13 +360,13 @@ TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
     off.structure_sigmas = 0;
     PlaneMap held, alone(off);
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> across(-2.9, -2.7), along(0.5, 3.0);
-    std::normal_distribution<double> noise(0, 0.01);
+    std::uniform_real_distribution<double> across(-2.95, -2.65), along(0.5, 3.0);
+    std::normal_distribution<double> noise(0, 0.006);
     for (int k = 0; k < 8; ++k) {
       PlaneObservation floor;
       floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
-      for (int i = 0; i < 12; ++i) {
-        floor.ids.push_back(5000 + 12 * k + i);
+      for (int i = 0; i < 20; ++i) {
+        floor.ids.push_back(5000 + 20 * k + i);
         floor.points.push_back({across(rng), -0.8 + noise(rng), along(rng)});
       }
       const auto walls = {observe(kWall, 0.0, 100 + 30 * k, 30, seed * 10 + k, 1.5),
@@ -381,12 +384,50 @@ TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
     const MapPlane* with = floorOf(held);
     const MapPlane* without = floorOf(alone);
     ASSERT_TRUE(with && without) << seed;
-    EXPECT_LT(normalAngleDeg(with->normal, kFloor), 0.5) << seed;
-    EXPECT_FALSE(with->confirmed(held.params())) << seed;  // still a strip by its points
+    ASSERT_LE(without->normal_sigma_deg, held.params().max_normal_sigma_deg) << seed;
+    // Never worse than alone; better on average (below). A draw whose points lean by 3
+    // of their sigmas keeps its lean: they deny the walls' right angle.
+    EXPECT_LE(normalAngleDeg(with->normal, kFloor), normalAngleDeg(without->normal, kFloor) + 0.05)
+        << seed;
     EXPECT_EQ(with->normal_sigma_deg, without->normal_sigma_deg);
-    EXPECT_EQ(with->observations, without->observations);  // views spaced by its own plane
+    EXPECT_EQ(with->confirmed(held.params()), without->confirmed(alone.params()));
+    EXPECT_EQ(with->observations, without->observations);
+    // Its own plane is the fit without the walls, what the map without structure has.
+    EXPECT_LT(normalAngleDeg(with->own_normal, without->normal), 1e-9) << seed;
+    EXPECT_NEAR(with->own_distance, without->distance, 1e-12);
+    EXPECT_GT(normalAngleDeg(with->own_normal, with->normal), 0.0);
     held_sum += normalAngleDeg(with->normal, kFloor);
     free_sum += normalAngleDeg(without->normal, kFloor);
   }
+  std::printf("floor strip: alone %.2f deg, held %.2f deg (mean of 10 draws)\n", free_sum / 10,
+              held_sum / 10);
   EXPECT_GT(free_sum / 10, 2 * held_sum / 10);  // the strip alone is worse: a real test
+}
+
+// A plane its own points leave loose (over max_normal_sigma_deg) is not held: it would
+// swing to a reference by degrees.
+TEST(PlaneMap, ALooseStripIsNotHeld) {
+  const cv::Vec3d left(1, 0, 0);
+  PlaneMap map;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> across(-2.9, -2.7), along(0.5, 3.0);
+  std::normal_distribution<double> noise(0, 0.03);
+  for (int k = 0; k < 8; ++k) {
+    PlaneObservation floor;
+    floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
+    for (int i = 0; i < 12; ++i) {
+      floor.ids.push_back(5000 + 12 * k + i);
+      floor.points.push_back({across(rng), -0.8 + noise(rng), along(rng)});
+    }
+    std::vector<PlaneObservation> image = {observe(kWall, 0.0, 100 + 30 * k, 30, 10 + k, 1.5),
+                                           observe(left, -3.0, 1000 + 30 * k, 30, 20 + k, 1.5)};
+    if (k >= 4) image.push_back(floor);
+    map.update(image, 1000 + 0.1 * k);
+  }
+  const MapPlane* floor = nullptr;
+  for (const MapPlane& p : map.planes())
+    if (normalAngleDeg(p.normal, kFloor) < 30) floor = &p;
+  ASSERT_TRUE(floor);
+  EXPECT_GT(floor->normal_sigma_deg, map.params().max_normal_sigma_deg);
+  EXPECT_LT(normalAngleDeg(floor->normal, floor->own_normal), 1e-12);
 }

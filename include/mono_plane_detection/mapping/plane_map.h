@@ -38,9 +38,9 @@ struct MapParams {
   // And only once its points fix its normal to this (1 sigma, normal_sigma_deg): half the
   // 2 deg a mapped plane may be off. A strip of points leaves the plane free to turn.
   double max_normal_sigma_deg = 1.0;
-  // A plane is held at right angles to (or parallel to) better-known confirmed planes
-  // while its points do not reject that at this many of their standard deviations
-  // (mapping/structure_fit.h); 0: off, each plane fitted alone.
+  // A plane whose points fix its normal to max_normal_sigma_deg is held at right angles
+  // to (or parallel to) better-known confirmed planes while its points do not reject that
+  // at this many of their standard deviations (mapping/structure_fit.h); 0: off.
   double structure_sigmas = 3.0;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen

@@ -14,7 +14,7 @@
 namespace mono_plane_detection {
 
 struct ReferencePlane {
-  cv::Vec3d normal;          // unit
+  cv::Vec3d normal;          // (made unit here)
   double normal_sigma_deg;   // how well it is known (1 sigma)
 };
 
@@ -27,17 +27,18 @@ struct StructuredPlane {
 
 // The plane through `points` whose normal fuses the points' own information (their
 // scatter over the free fit's residual variance, at least floor_m^2: exact points are not
-// infinitely sure) with a right angle to, or parallelism with, each reference whose
-// relation the free normal is within `sigmas` combined 1-sigma errors of (its own
-// `normal_sigma_deg` and the reference's): a Gaussian prior on the normal per relation,
-// (n . m)^2 or |n x m|^2 over the reference's sigma^2. The fused normal is refused, and
-// the free plane returned, when the points' residual sum of squares grows by more than
-// sigmas^2 (in units of that variance) per degree of freedom the relations take (at most
-// two). `free_normal` must be the least-squares normal of `points`; with no relation
-// taken (sigmas <= 0, fewer than 4 points, no reference in reach) it is returned with its
-// distance through the points' centroid.
+// infinitely sure) with, for each reference, the nearer of a right angle to it or the
+// parallel: a Gaussian prior on the normal, (n . m)^2 or |n x m|^2 over the reference's
+// sigma^2. A relation is taken when the normal fused with it alone raises the points'
+// residual sum of squares by at most sigmas^2 (in units of that variance) per degree of
+// freedom it takes (a right angle 1, the parallel 2), so a relation the points deny (a
+// turn about an axis they fix) is left out without the others; the relations together
+// are held to the same test (at most two degrees of freedom), else none is taken.
+// `free_normal` must be the least-squares normal of `points`; with no relation taken
+// (sigmas <= 0, fewer than 4 points, no reference) it is returned with its distance
+// through the points' centroid.
 StructuredPlane structuredPlane(const std::vector<cv::Vec3d>& points,
-                                const cv::Vec3d& free_normal, double normal_sigma_deg,
+                                const cv::Vec3d& free_normal,
                                 const std::vector<ReferencePlane>& references, double sigmas,
                                 double floor_m);
 
