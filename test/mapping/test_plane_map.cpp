@@ -346,6 +346,25 @@ TEST(PlaneMap, APlaneFromMotionCountsItsFitsViewsAndSigma) {
   EXPECT_LE(map.planes()[0].normal_sigma_deg, 0.8);
 }
 
+namespace {
+
+// The humanoid's floor as it sees it at image k: `count` points of a strip along the left
+// wall (x in [x0, x1], z 0.5-3 m, y = -0.8 m with `noise`), new ids per image.
+PlaneObservation floorStrip(std::mt19937& rng, int k, int count, double x0, double x1,
+                            double noise) {
+  std::uniform_real_distribution<double> across(x0, x1), along(0.5, 3.0);
+  std::normal_distribution<double> off(0, noise);
+  PlaneObservation floor;
+  floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
+  for (int i = 0; i < count; ++i) {
+    floor.ids.push_back(5000 + count * k + i);
+    floor.points.push_back({across(rng), -0.8 + off(rng), along(rng)});
+  }
+  return floor;
+}
+
+}  // namespace
+
 // Indoor structure (map/structure_sigmas): a floor seen as a strip 0.3 m wide along a wall
 // (as the humanoid sees it) turns about the strip by its points' noise (0.6 cm: its
 // normal known to under 1 deg, max_normal_sigma_deg); once two walls are
@@ -360,15 +379,8 @@ TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
     off.structure_sigmas = 0;
     PlaneMap held, alone(off);
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> across(-2.95, -2.65), along(0.5, 3.0);
-    std::normal_distribution<double> noise(0, 0.006);
     for (int k = 0; k < 8; ++k) {
-      PlaneObservation floor;
-      floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
-      for (int i = 0; i < 20; ++i) {
-        floor.ids.push_back(5000 + 20 * k + i);
-        floor.points.push_back({across(rng), -0.8 + noise(rng), along(rng)});
-      }
+      const PlaneObservation floor = floorStrip(rng, k, 20, -2.95, -2.65, 0.006);
       const auto walls = {observe(kWall, 0.0, 100 + 30 * k, 30, seed * 10 + k, 1.5),
                           observe(left, -3.0, 1000 + 30 * k, 30, seed * 20 + k, 1.5)};
       std::vector<PlaneObservation> image(walls);
@@ -410,15 +422,8 @@ TEST(PlaneMap, ALooseStripIsNotHeld) {
   const cv::Vec3d left(1, 0, 0);
   PlaneMap map;
   std::mt19937 rng(4);
-  std::uniform_real_distribution<double> across(-2.9, -2.7), along(0.5, 3.0);
-  std::normal_distribution<double> noise(0, 0.03);
   for (int k = 0; k < 8; ++k) {
-    PlaneObservation floor;
-    floor.viewpoint = {-1.5, 0.8 + 0.01 * k, 0.5 + 0.3 * k};
-    for (int i = 0; i < 12; ++i) {
-      floor.ids.push_back(5000 + 12 * k + i);
-      floor.points.push_back({across(rng), -0.8 + noise(rng), along(rng)});
-    }
+    const PlaneObservation floor = floorStrip(rng, k, 12, -2.9, -2.7, 0.03);
     std::vector<PlaneObservation> image = {observe(kWall, 0.0, 100 + 30 * k, 30, 10 + k, 1.5),
                                            observe(left, -3.0, 1000 + 30 * k, 30, 20 + k, 1.5)};
     if (k >= 4) image.push_back(floor);

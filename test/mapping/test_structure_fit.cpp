@@ -12,22 +12,8 @@ namespace {
 
 const double kDeg = CV_PI / 180;
 
-// Points on the plane with normal n through the origin: a strip `length` x `width` m
-// (along u, v of planeAxes(n)), noise `noise` m across it.
-std::vector<cv::Vec3d> strip(const cv::Vec3d& n, double length, double width, int count,
-                             double noise, unsigned seed) {
-  cv::Vec3d u, v;
-  planeAxes(n, u, v);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> along(-length / 2, length / 2), across(-width / 2, width / 2);
-  std::normal_distribution<double> off(0, noise);
-  std::vector<cv::Vec3d> points;
-  for (int i = 0; i < count; ++i) points.push_back(along(rng) * u + across(rng) * v + off(rng) * n);
-  return points;
-}
-
-// (fitPlane refuses strips narrower than its spread check: the eigenvector here.)
-// The same with the strip's long axis along `along` (projected into the plane).
+// Points on the plane with normal n through the origin: a strip `length` x `width` m, its
+// long axis along `along` (projected into the plane), noise `noise` m across it.
 std::vector<cv::Vec3d> stripAlong(const cv::Vec3d& n, const cv::Vec3d& along, double length,
                                   double width, int count, double noise, unsigned seed) {
   const cv::Vec3d u = cv::normalize(along - along.dot(n) * n), v = n.cross(u);
@@ -39,6 +25,15 @@ std::vector<cv::Vec3d> stripAlong(const cv::Vec3d& n, const cv::Vec3d& along, do
   return points;
 }
 
+// The same along the first in-plane axis of planeAxes(n).
+std::vector<cv::Vec3d> strip(const cv::Vec3d& n, double length, double width, int count,
+                             double noise, unsigned seed) {
+  cv::Vec3d u, v;
+  planeAxes(n, u, v);
+  return stripAlong(n, u, length, width, count, noise, seed);
+}
+
+// (fitPlane refuses strips narrower than its spread check: the eigenvector here.)
 cv::Vec3d leastSquaresNormal(const std::vector<cv::Vec3d>& points, const cv::Vec3d& side) {
   cv::Vec3d centroid(0, 0, 0);
   for (const auto& p : points) centroid += p;
