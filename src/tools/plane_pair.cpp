@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   std::string img1, img2, overlay = "plane_pair.png", features = "sift", matches_file;
   int max_features = 4000;
   double ratio = 0.8;
-  bool json = false;
+  bool json = false, no_overlay = false;
   cli::Parser cli("plane_pair", "[options] IMG1 IMG2",
                   "  Planes between two real images: feature matches (SIFT or ORB, ratio test),\n"
                   "  undistorted with the given intrinsics (radial-tangential k1 k2 p1 p2 k3;\n"
@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
       .integer<unsigned>("seed", &params.groups.seed, 0, std::numeric_limits<unsigned>::max(),
                          "seed of the group choice", "S")
       .text("overlay", &overlay, "where to write the overlay image", "FILE.png")
+      .flag("no-overlay", &no_overlay, "write no overlay image")
       .text("matches", &matches_file,
             "also write every undistorted match as 'x1 y1 x2 y2' lines (segment_planes' input)",
             "FILE.txt")
@@ -184,6 +185,7 @@ int main(int argc, char** argv) {
     cv::putText(out, cv::format("plane %zu: %zu", k + 1, result.planes[k].inliers.size()),
                 {10, 20 + 20 * static_cast<int>(k)}, cv::FONT_HERSHEY_SIMPLEX, 0.55, colours[k % 8], 2,
                 cv::LINE_AA);
+  if (no_overlay) return 0;  // (scripts/eval_euroc without --overlays)
   if (!cv::imwrite(overlay, out)) return cli.fail("cannot write " + overlay);
   if (!json) std::printf("overlay: %s\n", overlay.c_str());
   return 0;

@@ -154,9 +154,9 @@ TEST(ToolsCli, PlanePairWritesItsMatchesForSegmentPlanes) {
   const std::string distorted = tempPath("plane_pair_matches_k1.txt");
   r = run(PLANE_PAIR_PATH, tum + "1341847987.758741.jpg " + tum +
                                "1341847989.802890.png --fx 535.4 --fy 539.2 --cx 320.1 --cy 247.6 "
-                               "--k1 -0.3 --features orb --overlay " + tempPath("plane_pair.png") +
-                               " --matches " + distorted);
+                               "--k1 -0.3 --features orb --no-overlay --matches " + distorted);
   ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("overlay:"), std::string::npos) << r.out;  // --no-overlay: none written
   auto points = [](const std::string& path) {
     std::ifstream in(path);
     std::vector<std::vector<double>> rows;
