@@ -381,8 +381,8 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
   }
   // How well its own points fix the normal decides confirmation, whatever the structure
   // below adds: a strip is not confirmed by being at right angles to a wall.
-  plane.normal_sigma_deg =
-      std::min(plane.motion_sigma_deg, normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m));
+  const double points_sigma_deg = normalSigmaDeg(inliers, fit.rms_m, params_.min_residual_m);
+  plane.normal_sigma_deg = std::min(plane.motion_sigma_deg, points_sigma_deg);
   plane.own_normal = fit.normal;
   plane.own_distance = fit.distance;
   // Held only once its own points fix its normal to a map's bound: a loose plane (a few
@@ -390,7 +390,7 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
   // association gate. The references' own planes, not their held ones: none is pulled back
   // by its own earlier pull through another.
   std::vector<ReferencePlane> references;
-  if (plane.normal_sigma_deg <= params_.max_normal_sigma_deg)
+  if (points_sigma_deg <= params_.max_normal_sigma_deg)
     for (const MapPlane& other : planes_)
       if (other.id != plane.id && other.id != merged && other.confirmed(params_) &&
           other.normal_sigma_deg < plane.normal_sigma_deg)

@@ -119,6 +119,19 @@ TEST(StructureFit, ARampsPointsDenyTheRightAngle) {
   EXPECT_LT(normalAngleDeg(held.normal, free), 1e-9);
 }
 
+// The same ramp's points spread and nearly exact (its normal known to about 0.03 deg)
+// against a loose reference (0.5 deg) 10 deg from its right angle: the points' residuals
+// hardly notice the fused normal, so the relation passes, and moves the plane only by the
+// reference's share, 10 deg x 0.03^2 / (0.03^2 + 0.5^2), about 0.04 deg.
+TEST(StructureFit, ALooseReferenceMovesAWellKnownPlaneByItsShareOnly) {
+  const cv::Vec3d ramp = turned(kUp, kLeft, 10.0);
+  const auto points = strip(ramp, 1.0, 1.0, 60, 0.001, 14);
+  const cv::Vec3d free = leastSquaresNormal(points, kUp);
+  const StructuredPlane held = structuredPlane(points, free, {{kFront, 0.5}}, 3.0, 0.0005);
+  EXPECT_LT(normalAngleDeg(held.normal, free), 0.1);
+  EXPECT_LT(normalAngleDeg(held.normal, ramp), 0.1);
+}
+
 // A ramp 4 deg from level seen as a strip up its slope, between a front wall it rises
 // towards and a side wall along it: its 2 m length fixes the slope, so its points deny
 // the right angle to the front wall (a turn about the axis they fix), but its 0.2 m width

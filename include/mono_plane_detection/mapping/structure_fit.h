@@ -29,14 +29,13 @@ struct StructuredPlane {
 // scatter over the free fit's residual variance, at least floor_m^2: exact points are not
 // infinitely sure) with, for each reference, the nearer of a right angle to it or the
 // parallel: a Gaussian prior on the normal, (n . m)^2 or |n x m|^2 over the reference's
-// sigma^2. A relation is taken when the normal fused with it alone raises the points'
-// residual sum of squares by at most sigmas^2 (in units of that variance) per degree of
-// freedom it takes (a right angle 1, the parallel 2), so a relation the points deny (a
-// turn about an axis they fix) is left out without the others; the relations together
-// are held to the same test (at most two degrees of freedom), else none is taken.
-// `free_normal` must be the least-squares normal of `points`; with no relation taken
-// (sigmas <= 0, fewer than 4 points, no reference) it is returned with its distance
-// through the points' centroid.
+// sigma^2. References are taken best-known first; each is kept while the points'
+// residual sum of squares under the fused normal grows by at most sigmas^2 (in units of
+// their residual variance) per degree of freedom the kept relations take (a right angle
+// 1, the parallel 2, at most 2 in all), so a relation the points deny (a turn about an
+// axis they fix) is left out without the others. `free_normal` must be the
+// least-squares normal of `points`; with no relation taken (sigmas <= 0, fewer than 4
+// points, no reference) it is returned with its distance through the points' centroid.
 StructuredPlane structuredPlane(const std::vector<cv::Vec3d>& points,
                                 const cv::Vec3d& free_normal,
                                 const std::vector<ReferencePlane>& references, double sigmas,
