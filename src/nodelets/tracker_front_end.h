@@ -47,6 +47,7 @@ struct TrackerCounts {
   long camera_switches = 0;  // frame_id or size changed from one image to the next
   long backwards = 0;        // stamps went back (a bag loop): tracking started over
   long info_size_mismatch = 0;  // images the camera_info was not used for (another size)
+  long info_frame_mismatch = 0;  // images whose camera_info names another frame_id
   long lost = 0;             // points lost, total
   long searches = 0;         // corner searches, total
   int tracked_now = 0;
@@ -99,6 +100,7 @@ class TrackerFrontEnd {
   uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet
   cv::Size last_size_;
   std::string last_frame_id_;
+  std::string info_frame_id_;  // of the last usable camera_info
   bool rectified_ = false;
   // The usable camera_infos (K and D, or P when rectified): the lens the target is
   // undistorted with, given to the target start-up only for images of its size.

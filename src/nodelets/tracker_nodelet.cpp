@@ -257,6 +257,7 @@ class TrackerNodelet : public nodelet::Nodelet {
                                                                    "(the newest is for another size)"
                                                                  : "for another image size: not used");
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
+    status.add("images with camera_info of another frame_id (total)", c.info_frame_mismatch);
     // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).
     status.add("resets (total)", resets_ + c.backwards);
     status.add("resets: time went backwards (total)", c.backwards);

@@ -332,6 +332,35 @@ TEST_F(TrackerNodeletTest, BadOrMismatchedCameraInfoDoesNotStopTracking) {
   EXPECT_EQ(diagnostics.message().rfind("camera_info unusable", 0), 0u) << diagnostics.message();
 }
 
+// A camera_info of another frame than the images' (another camera's, through a remap
+// gone wrong) is used all the same, but counted and said.
+TEST_F(TrackerNodeletTest, CameraInfoOfAnotherFrameIsCounted) {
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  ros::Publisher info_pub = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long before = diagnostics.number("images with camera_info of another frame_id (total)");
+  ASSERT_GE(before, 0);
+  sensor_msgs::CameraInfo left;
+  left.header.frame_id = "left_camera_optical";
+  left.width = 640;
+  left.height = 480;
+  left.K = {525, 0, 320, 0, 525, 240, 0, 0, 1};
+  info_pub.publish(left);
+  scaledWait(0.3).sleep();
+  for (int k = 0; k < 3; ++k)
+    ASSERT_TRUE(send(makeImage(view({0.5 * k, 0}), "mono8", stamp_ += 0.1)));  // camera_optical
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("images with camera_info of another frame_id (total)") - before, 3);
+  EXPECT_EQ(diagnostics.value("camera_info"), "ok");  // used all the same
+  sensor_msgs::CameraInfo own = left;  // its own frame: no more counted
+  own.header.frame_id = "camera_optical";
+  info_pub.publish(own);
+  scaledWait(0.3).sleep();
+  ASSERT_TRUE(send(makeImage(view({1.5, 0}), "mono8", stamp_ += 0.1)));
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("images with camera_info of another frame_id (total)") - before, 3);
+}
+
 TEST_F(TrackerNodeletTest, DebugImageWhileSubscribed) {
   sensor_msgs::ImageConstPtr debug;
   ros::Subscriber sub = nh_.subscribe<sensor_msgs::Image>(
