@@ -126,9 +126,19 @@ class PlaneNodelet : public nodelet::Nodelet {
       NODELET_INFO("rectified images (%s): camera_info's P is used, without distortion",
                    node.rectified ? "parameter rectified" : image_topic.c_str());
 
-    planes_pub_ = nh.advertise<PlaneArray>("planes", 5);
-    image_planes_pub_ = nh.advertise<PlaneArray>("image_planes", 5);
-    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("camera_pose", 5);
+    // Tracks held by an odometry wait are processed in one burst when it ends (one
+    // callback of this nodelet's single-threaded queue) while new ones queue in the
+    // subscription: deep enough for a wait's worth of images at 30 Hz and two more, no
+    // deeper (on a machine too slow for the image rate every answer is a queue length
+    // old). The burst's answers are published at once, faster than roscpp's writer thread
+    // may send them to another process: the per-image answers queue as deep.
+    const uint32_t burst =
+        odom_frame_.empty() ? 5
+                            : static_cast<uint32_t>(std::clamp<double>(
+                                  std::ceil(odom_wait_s_ * 30) + 2, 5, kMaxPending));
+    planes_pub_ = nh.advertise<PlaneArray>("planes", burst);
+    image_planes_pub_ = nh.advertise<PlaneArray>("image_planes", burst);
+    pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("camera_pose", burst);
     markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>("plane_markers", 5);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("map_points", 2);
     image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
@@ -161,16 +171,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                                                   [this](const auto&) { drain(); }),
                                       true /* oneshot */, false /* autostart */);
     // The map must follow every image, so tracks are always subscribed (the tracker
-    // itself runs lazily: only while this nodelet listens). Tracks held by an odometry
-    // wait are processed in one burst when it ends (one callback of this nodelet's
-    // single-threaded queue) while new ones queue here: deep enough for a wait's worth of
-    // images at 30 Hz and two more, no deeper (on a machine too slow for the image rate
-    // every answer is a queue length old).
-    const uint32_t tracks_queue =
-        odom_frame_.empty() ? 5
-                            : static_cast<uint32_t>(std::clamp<double>(
-                                  std::ceil(odom_wait_s_ * 30) + 2, 5, kMaxPending));
-    tracks_sub_ = nh.subscribe<Tracks>("tracks", tracks_queue,
+    // itself runs lazily: only while this nodelet listens); queued as deep as a burst.
+    tracks_sub_ = nh.subscribe<Tracks>("tracks", burst,
                                        guard_.message("tracks", this, &PlaneNodelet::onTracks));
     info_sub_ = nh.subscribe<sensor_msgs::CameraInfo>(
         "camera_info", 2, guard_.message("camera_info", this, &PlaneNodelet::onCameraInfo));
