@@ -33,6 +33,7 @@ struct CameraIntrinsics {
   cv::Mat D;          // OpenCV's model (plumb_bob, rational_polynomial); empty: none
   cv::Mat fisheye_D;  // equidistant (1 x 4): tracks go through undistortFisheye first
   bool rectified = false;
+  std::string frame_id;  // camera_info's header.frame_id, tf style (no leading '/')
 };
 
 // rectified: the stream is rectified (P, no distortion), else raw (K, D). Empty when
@@ -46,6 +47,13 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
 // `earlier_kept`: an earlier camera_info of their size still is (CalibrationHolder).
 std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size,
                              bool earlier_kept = false);
+
+// Empty when the camera used for images of frame `image_frame_id` names that frame (or
+// either names none), else the WARN both nodelets give: drivers give an image and its
+// camera_info one frame_id, so another one is most often the other camera's camera_info
+// (a remap gone wrong, of the same size). It is used all the same (a driver may name
+// them apart).
+std::string infoFrameMismatch(const CameraIntrinsics& camera, const std::string& image_frame_id);
 
 // Which calibration describes the images: the last usable camera_info when it is of their
 // size, else the last one that was. A stray camera_info of another size (a second driver

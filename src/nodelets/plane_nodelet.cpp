@@ -295,7 +295,6 @@ class PlaneNodelet : public nodelet::Nodelet {
       return;
     }
     calibration_.offer(camera);  // (its size with binning and ROI applied)
-    info_frame_ = tfFrame(msg->header.frame_id);
   }
 
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -688,17 +687,13 @@ class PlaneNodelet : public nodelet::Nodelet {
         ++info_size_mismatch_;
         if (logNow("info size", 10.0)) NODELET_ERROR("%s", info_mismatch.c_str());
       }
-      // Drivers give an image and its camera_info one frame_id: another one is most often
-      // the other camera's camera_info (a remap gone wrong, intrinsics of the same size).
-      // Used all the same (a driver may name them apart), said once per pair, counted.
-      const std::string tracks_frame = tfFrame(msg.header.frame_id);
-      if (camera && !info_frame_.empty() && !tracks_frame.empty() && info_frame_ != tracks_frame) {
-        ++info_frame_mismatch_;
-        if (warned_frames_ != info_frame_ + "|" + tracks_frame) {
-          warned_frames_ = info_frame_ + "|" + tracks_frame;
-          NODELET_WARN("camera_info on %s is of frame '%s', the tracks of '%s': another "
-                       "camera's? Used all the same; remap camera_info to this camera's",
-                       info_sub_.getTopic().c_str(), info_frame_.c_str(), tracks_frame.c_str());
+      // Another camera's camera_info? Used all the same, said once per text, counted.
+      if (camera) {
+        if (std::string other = infoFrameMismatch(*camera, msg.header.frame_id); !other.empty()) {
+          ++info_frame_mismatch_;
+          if (other != warned_frames_)
+            NODELET_WARN("%s (%s)", other.c_str(), info_sub_.getTopic().c_str());
+          warned_frames_ = other;
         }
       }
       if (camera) {
@@ -939,8 +934,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   CalibrationHolder calibration_;       // the usable camera_infos
   long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
   long info_frame_mismatch_ = 0;        // tracks whose camera_info names another frame
-  std::string info_frame_;              // of the last camera_info taken
-  std::string warned_frames_;           // the last "info|tracks" frame pair warned of
+  std::string warned_frames_;           // the last camera_info frame mismatch warned of
   long backwards_resets_ = 0;           // map resets because time went backwards
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()

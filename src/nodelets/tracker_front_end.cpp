@@ -63,10 +63,7 @@ std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) 
   // A raw image's K and D, a rectified one's P (image_geometry's camera model).
   CameraIntrinsics lens;
   if (error.empty()) error = intrinsicsFromCameraInfo(info, rectified_, lens);
-  if (error.empty()) {
-    calibration_.offer(lens);  // (binning and ROI applied)
-    info_frame_id_ = info.header.frame_id;
-  }
+  if (error.empty()) calibration_.offer(lens);  // (binning and ROI applied)
   return error;
 }
 
@@ -234,16 +231,11 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   // The last one of this size is used, else none.
   const CameraIntrinsics* lens = calibration_.forImages(image.size(), out.info_mismatch);
   if (!out.info_mismatch.empty()) ++counts_.info_size_mismatch;
-  // A driver gives an image and its camera_info one frame_id: another is most often the
-  // other camera's camera_info (a remap gone wrong, of the same size). Used all the same.
-  auto bare = [](const std::string& frame) { return frame.rfind('/', 0) == 0 ? frame.substr(1) : frame; };
-  if (lens && !info_frame_id_.empty() && !msg->header.frame_id.empty() &&
-      bare(info_frame_id_) != bare(msg->header.frame_id)) {
-    ++counts_.info_frame_mismatch;
-    out.warnings.push_back({"camera_info frame", "camera_info is of frame '" + info_frame_id_ +
-                                                     "', the images of '" + msg->header.frame_id +
-                                                     "': another camera's? Used all the same; "
-                                                     "remap camera_info to this camera's"});
+  if (lens) {
+    if (std::string other = infoFrameMismatch(*lens, msg->header.frame_id); !other.empty()) {
+      ++counts_.info_frame_mismatch;
+      out.warnings.push_back({"camera_info frame", other});
+    }
   }
   tracker_.process(image);
   // The target is searched with the lens undone (straight sides) and its aspect judged

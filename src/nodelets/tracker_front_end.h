@@ -100,7 +100,6 @@ class TrackerFrontEnd {
   uint64_t last_stamp_ns_ = 0;  // of the last image tracked; 0: none yet
   cv::Size last_size_;
   std::string last_frame_id_;
-  std::string info_frame_id_;  // of the last usable camera_info
   bool rectified_ = false;
   // The usable camera_infos (K and D, or P when rectified): the lens the target is
   // undistorted with, given to the target start-up only for images of its size.

@@ -172,8 +172,7 @@ int main(int argc, char** argv) {
         for (size_t p = 0; p < truth.size(); ++p)
           if (shares[p] > truth[p].max_image_share) {
             truth[p].max_image_share = shares[p];
-            truth[p].range_m = std::abs(scene.planes[p].normal().dot(world_from_camera.t) -
-                                        scene.planes[p].distance());
+            truth[p].range_m = scene.planes[p].distanceFrom(world_from_camera.t);
           }
       }
       const cv::Mat image = renderer.render(world_from_camera,

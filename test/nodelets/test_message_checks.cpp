@@ -234,6 +234,26 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
 
 // A stray camera_info of another size (a second driver on the topic) does not take the
 // calibration from the images: the last one of their size stays, the mismatch is named.
+// The camera_info's frame against the images': tf names (a leading '/' is the same
+// frame), an empty name on either side says nothing.
+TEST(CameraInfoCheck, AnotherFramesCameraInfoIsNamed) {
+  sensor_msgs::CameraInfo info = cameraInfo({});
+  info.header.frame_id = "/left_camera_optical";
+  CameraIntrinsics camera;
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  EXPECT_EQ(camera.frame_id, "left_camera_optical");
+  EXPECT_EQ(infoFrameMismatch(camera, "left_camera_optical"), "");
+  EXPECT_EQ(infoFrameMismatch(camera, "/left_camera_optical"), "");
+  EXPECT_EQ(infoFrameMismatch(camera, ""), "");
+  const std::string other = infoFrameMismatch(camera, "right_camera_optical");
+  EXPECT_NE(other.find("camera_info is of frame 'left_camera_optical', the images of "
+                       "'right_camera_optical'"),
+            std::string::npos)
+      << other;
+  camera.frame_id.clear();
+  EXPECT_EQ(infoFrameMismatch(camera, "right_camera_optical"), "");
+}
+
 TEST(CalibrationHolder, TheLastCameraInfoOfTheImagesSizeIsUsed) {
   CameraIntrinsics vga, sensor, vga2;
   vga.size = {640, 480};

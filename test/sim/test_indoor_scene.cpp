@@ -17,6 +17,13 @@ TEST(IndoorScene, RoomPlanesFaceTheRobot) {
         << p.name << " normal points out of the room";
     for (const auto& c : p.corners()) EXPECT_NEAR(p.normal().dot(c), p.distance(), 1e-12);
   }
+  // A camera 0.8 m above the floor is 0.8 m from it, on either side of it.
+  const ScenePlane* floor = nullptr;
+  for (const auto& p : scene.planes)
+    if (p.name == "floor") floor = &p;
+  ASSERT_TRUE(floor);
+  EXPECT_NEAR(floor->distanceFrom(start), 0.8, 1e-12);
+  EXPECT_NEAR(floor->distanceFrom({1, 2, -0.8}), 0.8, 1e-12);
   RoomParams bare;
   bare.walls = 1;
   bare.ceiling = false;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <string>
@@ -31,6 +32,8 @@ struct ScenePlane {
   // True when (a, b) lies on the plane's rectangle and not in a hole.
   bool contains(double a, double b) const;
   double distance() const { return normal().dot(origin); }  // plane: normal . X = distance
+  // How far a point (a camera centre) is from the plane, m.
+  double distanceFrom(const cv::Vec3d& point) const { return std::abs(normal().dot(point) - distance()); }
   std::array<cv::Vec3d, 4> corners() const;
 };
 

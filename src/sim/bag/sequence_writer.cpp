@@ -106,8 +106,7 @@ void writeGroundTruth(const SequenceSpec& spec, const IndoorScene& scene, const 
     for (size_t i = 0; i < shares.size(); ++i) {
       if (shares[i] <= max_share[i]) continue;
       max_share[i] = shares[i];
-      range[i] = std::abs(scene.planes[i].normal().dot(world_from_camera.t) -
-                          scene.planes[i].distance());
+      range[i] = scene.planes[i].distanceFrom(world_from_camera.t);
     }
   }
   for (size_t i = 0; i < scene.planes.size(); ++i) {
