@@ -109,6 +109,36 @@ TEST(PlanePipeline, TimeGoingBackwardsResetsAPauseIsATrackingLoss) {
   EXPECT_TRUE(pipeline.map().planes().empty());
 }
 
+// dynamic_reconfigure's path: the per-image parameters take effect on the next image,
+// without a restart (the map and the image history are kept).
+TEST(PlanePipeline, PerImageParamsApplyToTheNextImage) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;  // no intrinsics: the reference is frame_gap images back
+  PipelineResult r;
+  size_t most = 0;
+  for (int k = 0; k < 30; ++k) {
+    r = pipeline.process(world.frame(k / 30.0));
+    most = std::max(most, r.planes.size());
+  }
+  ASSERT_GE(most, 2u);  // the room's planes, more than one at a time
+  EXPECT_NEAR(r.reference_stamp, world.frame((29 - 5) / 30.0).stamp, 1e-9);
+  PlaneParams one_plane;
+  one_plane.max_planes = 1;
+  pipeline.setPerImageParams(one_plane, 8, 5.0);
+  EXPECT_EQ(pipeline.params().frame_gap, 8);
+  for (int k = 30; k < 40; ++k) {
+    r = pipeline.process(world.frame(k / 30.0));
+    EXPECT_NEAR(r.reference_stamp, world.frame((k - 8) / 30.0).stamp, 1e-9) << k;
+    EXPECT_LE(r.planes.size(), 1u) << k;
+  }
+  // A pause of 2 s is no tracking loss under max_gap_s 5 (it is under the default 1).
+  r = pipeline.process(world.frame(40 / 30.0 + 2.0));
+  EXPECT_FALSE(r.tracking_loss);
+  pipeline.setPerImageParams(PlaneParams(), 5, 1.0);
+  r = pipeline.process(world.frame(40 / 30.0 + 4.0));
+  EXPECT_TRUE(r.tracking_loss);
+}
+
 // A 1 Hz stream (a low-rate bag): its one second between images is its rhythm, learnt
 // from the first pauses; a pause is then over 3 of its periods.
 TEST(PlanePipeline, LowRateStreamIsNotAPauseOnceItsPeriodIsKnown) {

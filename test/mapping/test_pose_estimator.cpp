@@ -212,6 +212,39 @@ TEST(PoseEstimator, ForgetsLandmarksBeyondTheBound) {
   }
 }
 
+// A pose from the landmarks further than max_jump_m from the last one is refused (a
+// wrong PnP); after a pause the caller says forgetLastPose() and the next one is taken.
+TEST(PoseEstimator, AJumpIsRefusedUntilTheLastPoseIsForgotten) {
+  const SyntheticTracks world("wheeled");
+  PoseEstimator estimator(world.camera.K(), world.camera.distortion());
+  for (int k = 0; k < 90; ++k) estimator.update(world.frame(k / 30.0));
+  ASSERT_TRUE(estimator.initialised());
+  // The view from 0.6 m aside (max_jump_m 0.5), without the target's corners: only the
+  // landmarks can place it.
+  const double t = 90 / 30.0;
+  Pose aside = trajectoryPose(world.trajectory, t);
+  aside.t += aside.R * cv::Vec3d(0.6, 0, 0);  // along the camera's x (right)
+  auto withoutTarget = [](TrackFrame f) {
+    TrackFrame out = f;
+    out.ids.clear();
+    out.pixels.clear();
+    out.target_corner.clear();
+    for (size_t i = 0; i < f.ids.size(); ++i) {
+      if (f.target_corner[i]) continue;
+      out.ids.push_back(f.ids[i]);
+      out.pixels.push_back(f.pixels[i]);
+      out.target_corner.push_back(false);
+    }
+    return out;
+  };
+  EXPECT_FALSE(estimator.update(withoutTarget(world.frameAt(aside, 1000 + t))));
+  estimator.forgetLastPose();
+  const auto e = estimator.update(withoutTarget(world.frameAt(aside, 1000 + t + 1 / 30.0)));
+  ASSERT_TRUE(e);
+  EXPECT_EQ(e->source, PoseSource::kLandmarks);
+  EXPECT_LT(cv::norm(e->map_from_camera.t - (world.map_from_world * aside).t), 0.03);
+}
+
 TEST(PoseEstimator, SourceNames) {
   EXPECT_STREQ(toString(PoseSource::kTarget), "target");
   EXPECT_STREQ(toString(PoseSource::kLandmarks), "landmarks");

@@ -69,6 +69,45 @@ TEST(ParamTable, NestedNamesReachTheNestedFields) {
             "pose/two_view/min_parallax_deg");
 }
 
+TEST(ParamTable, AppendNestedPrefixesNamesAndKeepsEachRow) {
+  // appendNested on its own, with two toy structs: each row of the sub-table once, its
+  // name prefixed, its range, unit, description and old name as they were, its field
+  // the nested member's.
+  struct Inner {
+    double gain = 1.5;
+    int count = 3;
+  };
+  struct Outer {
+    Inner inner;
+    int own = 0;
+  };
+  const ParamTable<Inner> inner{
+      {"gain", field(&Inner::gain), 0.0, 10.0, "px", "how much", "old_gain"},
+      {"count", field(&Inner::count), 1, 9, "", "how many"}};
+  ParamTable<Outer> outer{{"own", field(&Outer::own), 0, 5, "", "its own"}};
+  appendNested(outer, "inner/", &Outer::inner, inner);
+  ASSERT_EQ(outer.size(), 3u);
+  EXPECT_EQ(outer[0].name, "own");
+  EXPECT_EQ(outer[1].name, "inner/gain");
+  EXPECT_EQ(outer[1].old_name, "old_gain");
+  EXPECT_EQ(outer[1].unit, "px");
+  EXPECT_EQ(outer[1].description, "how much");
+  EXPECT_EQ(outer[1].max, 10.0);
+  EXPECT_EQ(outer[2].name, "inner/count");
+  EXPECT_EQ(outer[2].old_name, "");
+  EXPECT_EQ(outer[2].min, 1.0);
+  Outer o;
+  EXPECT_EQ(*std::get<double*>(outer[1].field(o)), 1.5);
+  *std::get<int*>(outer[2].field(o)) = 7;
+  EXPECT_EQ(o.inner.count, 7);
+  // validate() reaches the nested field through it.
+  o.inner.gain = 11;
+  const std::vector<std::string> errors = validate(o, outer);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("inner/gain = 11"), std::string::npos) << errors[0];
+  EXPECT_EQ(o.inner.gain, 1.5);
+}
+
 // Issue 15, cases 5 and 8: these values reached OpenCV (assert) or took 8 s per image.
 TEST(ParamTable, ValidateRepairsOutOfRangeValuesAndSaysWhy) {
   TrackerParams p;

@@ -252,3 +252,29 @@ TEST(CoplanarGroups, FifthPointsShareTheirFour) {
     shared += std::equal(single[i].begin(), single[i].begin() + 4, single[i - 1].begin());
   EXPECT_EQ(shared, 0u);
 }
+
+TEST(CoplanarGroups, SamplerDrawsOnDemandAndStopsOnDegeneratePoints) {
+  // GroupSampler itself: its first groups are buildGroups' (which only collects them),
+  // it goes on drawing past any count, and it gives up on points that allow no group.
+  TwoViewSceneParams sp;
+  sp.outlier_fraction = 0;
+  const auto scene = makeTwoViewScene(sp);
+  const GroupParams params;
+  GroupSampler sampler(scene.view2, params);
+  std::vector<PointGroup> drawn(300);
+  for (PointGroup& g : drawn) ASSERT_TRUE(sampler.next(g));
+  EXPECT_EQ(std::vector<PointGroup>(drawn.begin(), drawn.begin() + 50),
+            buildGroups(scene.view2, params, 50));
+  // More groups than seeds: the seeds are visited round after round.
+  EXPECT_GT(drawn.size(), scene.view2.size());
+
+  // Points on one line: every draw is degenerate; next() returns false, it does not spin.
+  std::vector<cv::Point2d> line;
+  for (int i = 0; i < 40; ++i) line.emplace_back(10.0 * i, 5.0 * i);
+  GroupSampler on_line(line, params);
+  PointGroup g;
+  EXPECT_FALSE(on_line.next(g));
+  EXPECT_FALSE(on_line.next(g));
+  GroupSampler four({{0, 0}, {100, 0}, {0, 100}, {100, 100}}, params);
+  EXPECT_FALSE(four.next(g));
+}

@@ -306,6 +306,23 @@ TEST(FeatureTracker, ResetKeepsIdsIncreasing) {
   for (const auto& p : tracker.process(view)) EXPECT_GT(p.id, highest);
 }
 
+TEST(FeatureTracker, FrameCountCountsProcessedImagesAcrossResets) {
+  // Like the ids, the image count goes on over a reset (lost points' ages are counted
+  // in it); a refused image is not counted.
+  FeatureTracker tracker;
+  EXPECT_EQ(tracker.frameCount(), 0);
+  const cv::Mat view = warpView(texture(), similarity(0, {}, kCentred), kView);
+  tracker.process(view);
+  tracker.process(view);
+  EXPECT_EQ(tracker.frameCount(), 2);
+  EXPECT_THROW(tracker.process(cv::Mat(10, 10, CV_32FC1)), std::invalid_argument);
+  EXPECT_EQ(tracker.frameCount(), 2);
+  tracker.reset();
+  EXPECT_EQ(tracker.frameCount(), 2);
+  tracker.process(view);
+  EXPECT_EQ(tracker.frameCount(), 3);
+}
+
 TEST(FeatureTracker, AddedTargetCornersAreTrackedAndKeepTheirFlag) {
   FeatureTracker tracker;
   const auto hs = translations(6, kCentred, {1.0, 0.5});

@@ -232,6 +232,10 @@ TEST(TargetStartup, DriftedTargetTracksAreReanchoredToTheDetectedCorners) {
   EXPECT_LT(sum / 32, 0.1);
   EXPECT_GT(worst_drifted, 0.5);  // the drift was there
   EXPECT_EQ(startup.reanchoredImages(), 8);
+  EXPECT_EQ(startup.followedImages(), 8);  // every image had all four target tracks
+  startup.reset();
+  EXPECT_EQ(startup.followedImages(), 0);
+  EXPECT_EQ(startup.reanchoredImages(), 0);
 }
 
 // A detection that does not agree with the tracks (here: tracks pushed 3 px away, more
@@ -275,6 +279,10 @@ TEST(TargetStartup, NoReanchorWhenTheDetectionDisagreesOrFails) {
     EXPECT_FALSE(startup.reanchored());
     after = targetTracks(tracker);
     for (int k = 0; k < 4; ++k) EXPECT_EQ(after[k].uv, before[k].uv) << "corner " << k;
+    // Re-detection on: three images followed with all four corners tracked, one of them
+    // re-anchored; off: the target is not followed at all.
+    EXPECT_EQ(startup.followedImages(), redetect ? 3 : 0);
+    EXPECT_EQ(startup.reanchoredImages(), redetect ? 1 : 0);
   }
 }
 
