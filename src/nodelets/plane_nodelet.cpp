@@ -724,12 +724,14 @@ class PlaneNodelet : public nodelet::Nodelet {
         odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
       }
       if (result.was_reset) {
-        // Rare (a bag loop): every time, whatever the clock did (a throttle on ros::Time
-        // was silenced by the loop itself).
-        NODELET_WARN(
-            "tracks stamp %.3f is before the previous one: time went backwards (bag "
-            "loop?), the map starts over",
-            frame.stamp);
+        // Rare (a bag loop): every time while loops come at most once a second, on the
+        // wall clock (a throttle on ros::Time was silenced by the loop itself); a flood
+        // of stamps going back and forth is limited as the tracker limits it.
+        if (logged_.note("backwards", "", 5.0, kRareEventBurst))
+          NODELET_WARN(
+              "tracks stamp %.3f is before the previous one: time went backwards (bag "
+              "loop?), the map starts over",
+              frame.stamp);
         mapStartedOver();
         ++resets_;
         ++backwards_resets_;

@@ -16,17 +16,27 @@
 
 namespace mono_plane_detection {
 
+// Lines per 5 s for rare events each worth its own line (a bag loop's reset): every loop
+// of a bag looping at most once a second is told; a flood (stamps going back and forth)
+// still gets 5 lines per 5 s, and the diagnostics count every one.
+constexpr size_t kRareEventBurst = 5;
+
 class RecentEvents {
  public:
-  // Records an event; true when its kind was not logged in the last period_s (log it).
-  bool note(const std::string& kind, const std::string& text, double period_s = 5.0) {
+  // Records an event; true when its kind was logged fewer than `burst` times in the last
+  // period_s (log it). A burst above 1 is for rare events each worth a line (a bag loop's
+  // reset), still limited when they come as a flood.
+  bool note(const std::string& kind, const std::string& text, double period_s = 5.0,
+            size_t burst = 1) {
     std::lock_guard<std::mutex> lock(mutex_);
     const ros::WallTime now = ros::WallTime::now();
     Event& e = events_[kind];
     e.last = now;
     e.text = text;
-    if (!e.logged.isZero() && (now - e.logged).toSec() < period_s) return false;
-    e.logged = now;
+    while (!e.logged.empty() && (now - e.logged.front()).toSec() >= period_s)
+      e.logged.erase(e.logged.begin());
+    if (e.logged.size() >= std::max<size_t>(1, burst)) return false;
+    e.logged.push_back(now);
     return true;
   }
 
@@ -48,7 +58,8 @@ class RecentEvents {
 
  private:
   struct Event {
-    ros::WallTime last, logged;
+    ros::WallTime last;
+    std::vector<ros::WallTime> logged;  // within the last period, oldest first
     std::string text;
   };
   mutable std::mutex mutex_;

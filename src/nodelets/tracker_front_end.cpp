@@ -202,7 +202,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
                                              " is before the previous one (" +
                                              seconds(last_stamp_ns_) +
                                              "): time went backwards (bag loop?), tracking "
-                                             "starts over"});
+                                             "starts over",
+                            kRareEventBurst});
     ++counts_.backwards;
     startOver(stamp_ns, true);
   } else if (last_stamp_ns_ != 0) {

@@ -15,6 +15,7 @@
 
 #include "camera_info_check.h"
 #include "image_input.h"
+#include "recent_events.h"
 #include "stretched_wait.h"
 #include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/params/param_table.h"
@@ -28,6 +29,9 @@ namespace mono_plane_detection {
 struct LogEvent {
   std::string kind;
   std::string text;
+  // Lines of this kind logged per 5 s of wall time: 1, or a few for rare events each
+  // worth its line (a bag loop's reset: every loop of a bag played fast is told).
+  size_t burst = 1;
 };
 
 struct TrackerOutput {

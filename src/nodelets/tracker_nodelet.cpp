@@ -144,7 +144,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   void warn(const LogEvent& event) {
     // A camera switch is also a problem of the stream for diagnostics (while recent).
     if (event.kind == "camera switch") problems_.note("camera switch", "image stream mixes cameras");
-    if (logged_.note(event.kind, event.text)) NODELET_WARN("%s", event.text.c_str());
+    if (logged_.note(event.kind, event.text, 5.0, event.burst)) NODELET_WARN("%s", event.text.c_str());
   }
 
 

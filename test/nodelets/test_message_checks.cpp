@@ -356,6 +356,29 @@ TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
   EXPECT_EQ(events.recent(0.01), Recent());  // none within the last 10 ms
 }
 
+// A burst: rare events each worth a line (a bag loop's reset) are logged up to `burst`
+// times per period, a flood of them no more; the diagnostics still see the last one.
+TEST(RecentEvents, ABurstLogsSeveralPerPeriodAndNoMore) {
+  RecentEvents events;
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(events.note("backwards", "loop", 0.2, 3)) << k;
+  EXPECT_FALSE(events.note("backwards", "loop 4", 0.2, 3));
+  EXPECT_FALSE(events.note("backwards", "loop 5", 0.2, 3));
+  EXPECT_EQ(events.recent(10).front().second, "loop 5");
+  ros::WallDuration(0.25).sleep();  // the period over: the next ones are logged again
+  EXPECT_TRUE(events.note("backwards", "loop 6", 0.2, 3));
+  // Burst 1 (the default) is one per period.
+  EXPECT_TRUE(events.note("gap", "pause", 0.2));
+  EXPECT_FALSE(events.note("gap", "pause", 0.2));
+  // The tracker's backwards event asks for the rare events' burst.
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  ASSERT_TRUE(front.process(image(grey, 100)).tracks);
+  const TrackerOutput back = front.process(image(grey, 99));
+  ASSERT_FALSE(back.warnings.empty());
+  EXPECT_EQ(back.warnings[0].kind, "backwards");
+  EXPECT_EQ(back.warnings[0].burst, kRareEventBurst);
+}
+
 // Issue 15, case 1: secs = 4000000000 after 100: ros::Duration threw out of the callback.
 TEST(TrackerFrontEnd, StampsBeyondTwoToThe31SecondsAreCompared) {
   TrackerFrontEnd front;
