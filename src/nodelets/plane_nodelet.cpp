@@ -319,10 +319,12 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   // What the map's output keeps beyond the pipeline, started over with it (mutex_ held).
-  void mapStartedOver() {
+  // The wait for the target goes on over a bag loop (the tracker's does too); a ~reset or
+  // another camera starts it again.
+  void mapStartedOver(bool keep_target_wait = false) {
     markers_shown_.clear();
     reset_markers_ = true;
-    target_wait_.reset();
+    if (!keep_target_wait) target_wait_.reset();
   }
 
   // A log line at most once per period_s of wall time per kind: ROS's _THROTTLE macros
@@ -732,7 +734,7 @@ class PlaneNodelet : public nodelet::Nodelet {
               "tracks stamp %.3f is before the previous one: time went backwards (bag "
               "loop?), the map starts over",
               frame.stamp);
-        mapStartedOver();
+        mapStartedOver(true);
         ++resets_;
         ++backwards_resets_;
         // Under simulated time the listener cleared its buffer when it saw the clock go
@@ -755,9 +757,10 @@ class PlaneNodelet : public nodelet::Nodelet {
         last_state_ = result.state;
       }
       // Waited in tracks stamps over the stretches of the stream (a pause or a jump of the
-      // stamps is a tracking loss: it closes one).
+      // stamps is a tracking loss, time going back a reset: each closes one), since the
+      // target was last seen, as the tracker counts it.
       if (result.state == PipelineState::kWaitingForTarget) {
-        if (result.tracking_loss) target_wait_.closeStretch();
+        if (result.tracking_loss || result.was_reset) target_wait_.closeStretch();
         target_wait_.seen(frame.stamp);
       } else {
         target_wait_.reset();

@@ -643,6 +643,30 @@ TEST(TrackerFrontEnd, NoTargetWarnsAfterTheTimeoutWithTheReason) {
   EXPECT_EQ(TrackerFrontEnd(params).targetDescription(), "ArUco marker DICT_4X4_50 id 0, 0.15 m");
 }
 
+// A bag looped: the target found in each loop after 1.5 s of images without it. The wait
+// is for a target not seen since it was last found: 1.5 s in every loop, never overdue
+// at a timeout of 2 s (it added up over the loops: 3 s in the second).
+TEST(TrackerFrontEnd, TheTargetWaitStartsOverOnceTheTargetIsFound) {
+  TrackerNodeParams params;
+  params.target_timeout_s = 2.0;
+  TrackerFrontEnd front(params);
+  EXPECT_EQ(front.setCameraInfo(cameraInfo({0, 0, 0, 0, 0})), "");
+  const cv::Mat grey = textured({640, 480});
+  cv::Mat sheet(480, 640, CV_8UC1, cv::Scalar(30));
+  sheet(cv::Rect(200, 150, 212, 150)).setTo(230);
+  for (int loop = 0; loop < 3; ++loop) {
+    for (int k = 0; k <= 15; ++k) {  // 10 Hz, 1.5 s without the target
+      front.process(image(grey, 100 + k / 10, (k % 10) * 100000000));
+      EXPECT_FALSE(front.targetOverdue()) << "loop " << loop << " image " << k;
+    }
+    EXPECT_NEAR(front.targetWaitS(), 1.5, 1e-6) << "loop " << loop;
+    for (int k = 16; k < 22 && !front.targetFound(); ++k)
+      front.process(image(sheet, 100 + k / 10, (k % 10) * 100000000));
+    ASSERT_TRUE(front.targetFound()) << "loop " << loop << ": " << front.targetReason();
+    EXPECT_EQ(front.targetWaitS(), 0.0);
+  }
+}
+
 // The focal length from camera_info reaches the detector: a square seen head-on is not an
 // A4 sheet once the focal length is known (without it, some focal length would make it
 // one seen obliquely).
