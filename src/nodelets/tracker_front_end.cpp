@@ -263,8 +263,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
       if (params_.target.target_type == "sheet")
         what << " (" << std::lround(target->contrast) << " grey levels of contrast)";
       out.infos.push_back(what.str());
-      // The wait is for a target never seen: after a bag loop (or a loss) the search
-      // starts over, and so does its wait, as the plane nodelet's does.
+      // Found: the wait ends. After a bag loop (or a loss) the search starts over and
+      // its wait counts from there, as the plane nodelet's does.
       target_wait_.reset();
     } else if (targetOverdue()) {
       std::ostringstream why;
