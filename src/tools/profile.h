@@ -28,6 +28,20 @@ inline void flattenYaml(const YAML::Node& node, const std::string& prefix,
   }
 }
 
+// One name of a YAML file set through the table (a problem with its value appended to
+// errors); false when the table has no such name.
+template <class P>
+bool applyYamlKey(const std::string& path, const std::string& name, const YAML::Node& value,
+                  const ParamTable<P>& table, P& params, std::vector<std::string>& errors) {
+  const ParamSpec<P>* spec = findParam(table, name);
+  if (!spec) return false;
+  const std::string error =
+      value.IsScalar() ? setFromText(spec->field(params), value.Scalar(), spec->min, spec->max)
+                       : "not a single value";
+  if (!error.empty()) errors.push_back(path + ": " + name + ": " + error);
+  return true;
+}
+
 // Sets params from one YAML file through the table; returns one line per problem (file
 // unreadable, unknown name, wrong type, out of range: the default is kept).
 template <class P>
@@ -40,17 +54,9 @@ std::vector<std::string> applyYamlFile(const std::string& path, const ParamTable
     return {path + ": " + e.what()};
   }
   std::vector<std::string> errors;
-  for (const auto& [name, value] : keys) {
-    const ParamSpec<P>* spec = findParam(table, name);
-    if (!spec) {
+  for (const auto& [name, value] : keys)
+    if (!applyYamlKey(path, name, value, table, params, errors))
       errors.push_back(path + ": unknown parameter " + name);
-      continue;
-    }
-    const std::string error =
-        value.IsScalar() ? setFromText(spec->field(params), value.Scalar(), spec->min, spec->max)
-                         : "not a single value";
-    if (!error.empty()) errors.push_back(path + ": " + name + ": " + error);
-  }
   for (const std::string& error : validate(params)) errors.push_back(path + ": " + error);
   return errors;
 }
@@ -78,6 +84,41 @@ std::vector<std::string> loadProfile(const std::string& config_dir, const std::s
     return errors;
   }
   for (std::string& e : applyYamlFile(overlay, table, params)) errors.push_back(std::move(e));
+  return errors;
+}
+
+// A tool that runs both nodelets (run_pipeline): a named profile is each nodelet's own
+// overlay; a .yaml file is one file over both base files, each name set in the nodelet
+// (or both) whose table has it, an error only when neither has it. (Read for each nodelet
+// alone, every name of one nodelet was unknown to the other: no file could be used.)
+template <class A, class B>
+std::vector<std::string> loadProfiles(const std::string& config_dir, const std::string& profile,
+                                      const std::string& nodelet_a, const ParamTable<A>& table_a,
+                                      A& a, const std::string& nodelet_b,
+                                      const ParamTable<B>& table_b, B& b) {
+  const bool is_file = profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
+  const std::string base = is_file ? "default" : profile;
+  std::vector<std::string> errors = loadProfile(config_dir, nodelet_a, base, table_a, a);
+  for (std::string& e : loadProfile(config_dir, nodelet_b, base, table_b, b))
+    errors.push_back(std::move(e));
+  if (!is_file) return errors;
+  std::vector<std::pair<std::string, YAML::Node>> keys;
+  try {
+    flattenYaml(YAML::LoadFile(profile), "", keys);
+  } catch (const YAML::Exception& e) {
+    errors.push_back(profile + ": " + e.what());
+    return errors;
+  }
+  for (const auto& [name, value] : keys) {
+    std::vector<std::string> b_errors;  // a name both have: its problem said once
+    const bool in_a = applyYamlKey(profile, name, value, table_a, a, errors);
+    const bool in_b = applyYamlKey(profile, name, value, table_b, b, in_a ? b_errors : errors);
+    if (!in_a && !in_b)
+      errors.push_back(profile + ": unknown parameter " + name + " (neither " + nodelet_a +
+                       " nor " + nodelet_b + " has it)");
+  }
+  for (const std::string& error : validate(a)) errors.push_back(profile + ": " + error);
+  for (const std::string& error : validate(b)) errors.push_back(profile + ": " + error);
   return errors;
 }
 

@@ -81,7 +81,8 @@ int main(int argc, char** argv) {
               "height; judged after the rigid motion that best aligns the camera paths")
       .text("profile", &profile,
             "parameters: config/{tracker,planes}.yaml with the overlay of profile P (wheeled, "
-            "humanoid), or a .yaml file over them; auto: the trajectory's profile",
+            "humanoid), or one .yaml file over both (each name where the tracker's or the "
+            "planes' table has it); auto: the trajectory's profile",
             "P")
       .integer("frame-gap", &frame_gap, 0, 1000,
                "frames between the two views of the planes before the camera is placed (0: "
@@ -128,10 +129,9 @@ int main(int argc, char** argv) {
                                                                                   : "default";
   TrackerNodeParams tracker_node;
   PlaneNodeParams plane_node;
-  std::vector<std::string> errors =
-      loadProfile(MPD_CONFIG_DIR, "tracker", profile, trackerNodeParamTable(), tracker_node);
-  for (std::string& e : loadProfile(MPD_CONFIG_DIR, "planes", profile, planeNodeParamTable(), plane_node))
-    errors.push_back(std::move(e));
+  const std::vector<std::string> errors =
+      loadProfiles(MPD_CONFIG_DIR, profile, "tracker", trackerNodeParamTable(), tracker_node,
+                   "planes", planeNodeParamTable(), plane_node);
   if (!errors.empty()) {
     for (const std::string& e : errors) std::fprintf(stderr, "run_pipeline: %s\n", e.c_str());
     return 2;

@@ -99,6 +99,48 @@ TEST(Profile, TargetFileReachesBothNodelets) {
   EXPECT_EQ(planes.pipeline.frame_gap, 6);
 }
 
+// run_pipeline's --profile FILE: one file over both nodelets' base files, each name set
+// where its table has it (read for each nodelet alone, a tracker name was unknown to the
+// planes' table and the other way round: every file was refused).
+TEST(Profile, OneFileForBothNodeletsSetsEachNameWhereItIsKnown) {
+  const std::string dir = tempPath("config_both");
+  ASSERT_EQ(::mkdir(dir.c_str(), 0700) == 0 || errno == EEXIST, true);
+  std::ofstream(dir + "/tracker.yaml") << "max_features: 60\n";
+  std::ofstream(dir + "/planes.yaml") << "frame_gap: 6\n";
+  const std::string file = writeYaml(
+      "both.yaml", "max_features: 77\nmap:\n  min_points: 9\ntarget:\n  width_m: 0.2794\n");
+  TrackerNodeParams tracker;
+  PlaneNodeParams planes;
+  EXPECT_EQ(loadProfiles(dir, file, "tracker", trackerNodeParamTable(), tracker, "planes",
+                         planeNodeParamTable(), planes),
+            std::vector<std::string>());
+  EXPECT_EQ(tracker.tracker.max_features, 77);             // the tracker's name
+  EXPECT_EQ(planes.pipeline.map.min_points, 9);            // the planes' name
+  EXPECT_EQ(planes.pipeline.frame_gap, 6);                 // the base file kept
+  EXPECT_DOUBLE_EQ(tracker.target.width_m, 0.2794);        // a name both have: both
+  EXPECT_DOUBLE_EQ(planes.pipeline.target.width_m, 0.2794);
+  // A name neither has is one error naming it; a bad value of a shared name is one error.
+  const std::string bad =
+      writeYaml("bad.yaml", "max_feature: 77\ntarget:\n  width_m: fast\n");
+  const std::vector<std::string> errors = loadProfiles(
+      dir, bad, "tracker", trackerNodeParamTable(), tracker, "planes", planeNodeParamTable(), planes);
+  ASSERT_EQ(errors.size(), 2u) << errors[0];
+  EXPECT_NE(errors[0].find("unknown parameter max_feature (neither tracker nor planes"),
+            std::string::npos)
+      << errors[0];
+  EXPECT_NE(errors[1].find("target/width_m"), std::string::npos) << errors[1];
+  // A named profile is still each nodelet's own overlay.
+  TrackerNodeParams t2;
+  PlaneNodeParams p2;
+  EXPECT_TRUE(loadProfiles(std::string(SOURCE_DIR) + "/config", "humanoid", "tracker",
+                           trackerNodeParamTable(), t2, "planes", planeNodeParamTable(), p2)
+                  .empty());
+  TrackerNodeParams t3;
+  loadProfile(std::string(SOURCE_DIR) + "/config", "tracker", "humanoid", trackerNodeParamTable(),
+              t3);
+  EXPECT_EQ(t2.tracker.window_size_px, t3.tracker.window_size_px);
+}
+
 TEST(Profile, NoneKeepsTheCoreDefaultsAndUnknownProfilesAreNamed) {
   PlaneNodeParams p;
   EXPECT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "none",
