@@ -24,25 +24,54 @@ std::vector<cv::Vec3d> positions(const MapPlane& plane) {
   return out;
 }
 
-// Least-squares plane through points (centroid and smallest eigenvector).
-bool leastSquares(const std::vector<cv::Vec3d>& points, cv::Vec3d& normal, double& distance) {
-  if (points.size() < 3) return false;
-  cv::Vec3d centroid(0, 0, 0);
-  for (const auto& p : points) centroid += p;
-  centroid *= 1.0 / static_cast<double>(points.size());
+// The points' centroid and the eigen decomposition of their scatter per point (variances
+// along the eigenvectors, largest first): the least-squares plane's normal is the last
+// eigenvector, its residuals' mean square the last value, the points' spread across their
+// long in-plane axis the middle one.
+struct Spread {
+  cv::Vec3d centroid{0, 0, 0};
+  cv::Vec3d variances{0, 0, 0};
+  cv::Vec3d normal{0, 0, 1};
+};
+
+Spread spreadOf(const std::vector<cv::Vec3d>& points) {
+  Spread out;
+  for (const auto& p : points) out.centroid += p;
+  out.centroid *= 1.0 / static_cast<double>(points.size());
   cv::Matx33d scatter = cv::Matx33d::zeros();
   for (const auto& p : points) {
-    const cv::Vec3d d = p - centroid;
+    const cv::Vec3d d = p - out.centroid;
     scatter += d * d.t();
   }
   cv::Mat values, vectors;
-  cv::eigen(cv::Mat(scatter), values, vectors);  // descending
-  normal = cv::Vec3d(vectors.at<double>(2, 0), vectors.at<double>(2, 1), vectors.at<double>(2, 2));
-  distance = normal.dot(centroid);
+  cv::eigen(cv::Mat(scatter * (1.0 / static_cast<double>(points.size()))), values, vectors);
+  out.variances = cv::Vec3d(values.at<double>(0), values.at<double>(1), values.at<double>(2));
+  out.normal = cv::Vec3d(vectors.at<double>(2, 0), vectors.at<double>(2, 1), vectors.at<double>(2, 2));
+  return out;
+}
+
+// Least-squares plane through points.
+bool leastSquares(const std::vector<cv::Vec3d>& points, cv::Vec3d& normal, double& distance) {
+  if (points.size() < 3) return false;
+  const Spread spread = spreadOf(points);
+  normal = spread.normal;
+  distance = normal.dot(spread.centroid);
   return std::isfinite(distance);
 }
 
-double normalSigmaDeg(const std::vector<cv::Vec3d>& points, double rms_m, double floor_m);
+// How well the points fix the normal: the tilt about the points' long in-plane axis
+// that moves them by their rms, shrunk by sqrt(points). A strip of points (one seen edge
+// on, or a narrow band of a larger surface) leaves the plane free to turn about it.
+double normalSigmaDeg(const Spread& spread, size_t points, double rms_m, double floor_m) {
+  if (points < 3) return 180;
+  const double minor = std::sqrt(std::max(1e-12, spread.variances[1]));
+  const double sigma = std::max(rms_m, floor_m) / std::sqrt(static_cast<double>(points));
+  return std::atan2(sigma, minor) * 180 / CV_PI;
+}
+
+double normalSigmaDeg(const std::vector<cv::Vec3d>& points, double rms_m, double floor_m) {
+  return points.size() < 3 ? 180 : normalSigmaDeg(spreadOf(points), points.size(), rms_m, floor_m);
+}
 
 // Two groups of points on parallel surfaces (a shelf front and the wall beside it),
 // each seen as a narrow strip, always lie on one plane: a tilted one through both. Such
@@ -73,40 +102,19 @@ bool looksLikeTwoSurfaces(const std::vector<cv::Vec3d>& points, const cv::Vec3d&
         std::vector<cv::Vec3d> group;
         for (size_t j = side == 0 ? 0 : k; j < (side == 0 ? k : points.size()); ++j)
           group.push_back(points[along[j].second]);
-        cv::Vec3d n;
-        double d;
-        if (!leastSquares(group, n, d)) return true;
+        if (group.size() < 3) return true;
+        const Spread spread = spreadOf(group);
+        if (!std::isfinite(spread.normal.dot(spread.centroid))) return true;
         // A strip (its normal free to turn about its long axis) cannot confirm the plane.
-        double sum = 0;
-        for (const auto& p : group) sum += (n.dot(p) - d) * (n.dot(p) - d);
-        const double rms = std::sqrt(sum / static_cast<double>(group.size()));
-        const bool strip = normalSigmaDeg(group, rms, min_residual_m) > max_normal_sigma_deg;
-        const double angle = normalAngleDeg(n, normal);
+        const double rms = std::sqrt(std::max(0.0, spread.variances[2]));
+        const bool strip = normalSigmaDeg(spread, group.size(), rms, min_residual_m) >
+                           max_normal_sigma_deg;
+        const double angle = normalAngleDeg(spread.normal, normal);
         if (strip || std::min(angle, 180 - angle) > 10) return true;
       }
     }
   }
   return false;
-}
-
-// How well the points fix the normal: the tilt about the points' long in-plane axis
-// that moves them by their rms, shrunk by sqrt(points). A strip of points (one seen edge
-// on, or a narrow band of a larger surface) leaves the plane free to turn about it.
-double normalSigmaDeg(const std::vector<cv::Vec3d>& points, double rms_m, double floor_m) {
-  if (points.size() < 3) return 180;
-  cv::Vec3d centroid(0, 0, 0);
-  for (const auto& p : points) centroid += p;
-  centroid *= 1.0 / static_cast<double>(points.size());
-  cv::Matx33d scatter = cv::Matx33d::zeros();
-  for (const auto& p : points) {
-    const cv::Vec3d q = p - centroid;
-    scatter += q * q.t();
-  }
-  cv::Mat values;
-  cv::eigen(cv::Mat(scatter * (1.0 / static_cast<double>(points.size()))), values);
-  const double minor = std::sqrt(std::max(1e-12, values.at<double>(1)));
-  const double sigma = std::max(rms_m, floor_m) / std::sqrt(static_cast<double>(points.size()));
-  return std::atan2(sigma, minor) * 180 / CV_PI;
 }
 
 }  // namespace

@@ -102,6 +102,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       motion_planes_.clear();
       if (pose_) pose_->forgetLastPose();
       result.tracking_loss = true;
+      result.pause_s = since;
     } else {
       stream_.add(since_ns);
     }

@@ -99,8 +99,7 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
                                      CameraIntrinsics& out) {
   out = CameraIntrinsics();
   out.rectified = rectified;
-  out.frame_id = info.header.frame_id.rfind('/', 0) == 0 ? info.header.frame_id.substr(1)
-                                                          : info.header.frame_id;
+  out.frame_id = tfFrame(info.header.frame_id);
   image_geometry::PinholeCameraModel model;
   if (rectified) {
     // image_geometry: rectified pixels are those of P's left 3x3, without distortion
@@ -127,9 +126,12 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
   return fromCameraInfo(info, out.K, out.D);
 }
 
+std::string tfFrame(const std::string& frame_id) {
+  return frame_id.rfind('/', 0) == 0 ? frame_id.substr(1) : frame_id;
+}
+
 std::string infoFrameMismatch(const CameraIntrinsics& camera, const std::string& image_frame_id) {
-  const std::string image =
-      image_frame_id.rfind('/', 0) == 0 ? image_frame_id.substr(1) : image_frame_id;
+  const std::string image = tfFrame(image_frame_id);
   if (camera.frame_id.empty() || image.empty() || camera.frame_id == image) return {};
   return "camera_info is of frame '" + camera.frame_id + "', the images of '" + image +
          "': another camera's? Used all the same; remap camera_info to this camera's";

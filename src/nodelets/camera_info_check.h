@@ -48,6 +48,10 @@ std::string intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info, bool r
 std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_size,
                              bool earlier_kept = false);
 
+// A frame id as tf2 takes it: without a leading '/' (ROS 1 drivers of the tf1 era still
+// send one).
+std::string tfFrame(const std::string& frame_id);
+
 // Empty when the camera used for images of frame `image_frame_id` names that frame (or
 // either names none), else the WARN both nodelets give: drivers give an image and its
 // camera_info one frame_id, so another one is most often the other camera's camera_info

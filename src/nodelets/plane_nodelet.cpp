@@ -54,11 +54,6 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
   return tf;
 }
 
-// tf2 refuses frame ids with a leading '/' (ROS 1 drivers of the tf1 era still send them).
-std::string tfFrame(const std::string& frame_id) {
-  return frame_id.rfind('/', 0) == 0 ? frame_id.substr(1) : frame_id;
-}
-
 std::string sizeText(const cv::Size& size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
@@ -689,13 +684,12 @@ class PlaneNodelet : public nodelet::Nodelet {
         ++info_size_mismatch_;
         if (logNow("info size", 10.0)) NODELET_ERROR("%s", info_mismatch.c_str());
       }
-      // Another camera's camera_info? Used all the same, said once per text, counted.
+      // Another camera's camera_info? Used all the same, said (throttled) and counted.
       if (camera) {
         if (std::string other = infoFrameMismatch(*camera, msg.header.frame_id); !other.empty()) {
           ++info_frame_mismatch_;
-          if (other != warned_frames_)
+          if (logNow("info frame", 10.0))
             NODELET_WARN("%s (%s)", other.c_str(), info_sub_.getTopic().c_str());
-          warned_frames_ = other;
         }
       }
       if (camera) {
@@ -708,9 +702,6 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
                      info_sub_.getTopic().c_str());
       }
-      // The pause a tracking loss is about (the WARN says it, not the threshold).
-      const double gap_s = previous_stamp_ ? frame.stamp - *previous_stamp_ : 0.0;
-      previous_stamp_ = frame.stamp;
       // The core's axes (y up) for the odometry: with metric_source odometry the ROS map
       // is then the odometry frame itself (docs/ros_interface.md).
       const PipelineResult result =
@@ -751,7 +742,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN(
             "%.3f s without tracks: tracking lost, waiting for %s to place the camera "
             "again",
-            gap_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
+            result.pause_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
@@ -939,7 +930,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   CalibrationHolder calibration_;       // the usable camera_infos
   long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
   long info_frame_mismatch_ = 0;        // tracks whose camera_info names another frame
-  std::string warned_frames_;           // the last camera_info frame mismatch warned of
   long backwards_resets_ = 0;           // map resets because time went backwards
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
@@ -952,7 +942,6 @@ class PlaneNodelet : public nodelet::Nodelet {
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
-  std::optional<double> previous_stamp_;  // of the tracks processed last (under mutex_)
   std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
   StretchedWait target_wait_;  // for the metric start, in tracks stamps
   std::optional<Pose> last_odom_;

@@ -61,6 +61,11 @@ std::vector<std::string> applyYamlFile(const std::string& path, const ParamTable
   return errors;
 }
 
+// A --profile that names a .yaml file rather than a profile of config/.
+inline bool isProfileFile(const std::string& profile) {
+  return profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
+}
+
 // config/<nodelet>.yaml and config/target.yaml, then config/<nodelet>_<profile>.yaml over it
 // ("default": no overlay; "none": not even the base file, the core's defaults). A profile that is a
 // path to a .yaml file is read over the base file instead of an overlay.
@@ -69,7 +74,7 @@ std::vector<std::string> loadProfile(const std::string& config_dir, const std::s
                                      const std::string& profile, const ParamTable<P>& table,
                                      P& params) {
   if (profile == "none") return {};
-  const bool is_file = profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
+  const bool is_file = isProfileFile(profile);
   std::vector<std::string> errors = applyYamlFile(config_dir + "/" + nodelet + ".yaml", table, params);
   // The start-up target: one file for both nodelets, loaded by both launch files (a
   // config folder without it: the defaults, which are what it holds as shipped).
@@ -96,7 +101,7 @@ std::vector<std::string> loadProfiles(const std::string& config_dir, const std::
                                       const std::string& nodelet_a, const ParamTable<A>& table_a,
                                       A& a, const std::string& nodelet_b,
                                       const ParamTable<B>& table_b, B& b) {
-  const bool is_file = profile.size() > 5 && profile.substr(profile.size() - 5) == ".yaml";
+  const bool is_file = isProfileFile(profile);
   const std::string base = is_file ? "default" : profile;
   std::vector<std::string> errors = loadProfile(config_dir, nodelet_a, base, table_a, a);
   for (std::string& e : loadProfile(config_dir, nodelet_b, base, table_b, b))

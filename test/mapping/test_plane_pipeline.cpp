@@ -102,6 +102,7 @@ TEST(PlanePipeline, TimeGoingBackwardsResetsAPauseIsATrackingLoss) {
   EXPECT_FALSE(pipeline.map().planes().empty());
   PipelineResult r = pipeline.process(world.frame(3.0));  // 1 s later: > max_gap_s
   EXPECT_TRUE(r.tracking_loss);
+  EXPECT_NEAR(r.pause_s, 3.0 - 59 / 30.0, 1e-9);  // the pause itself, for the WARN
   EXPECT_FALSE(r.was_reset);
   EXPECT_FALSE(pipeline.map().planes().empty());  // the map is kept
   r = pipeline.process(world.frame(0.0));         // a bag loop

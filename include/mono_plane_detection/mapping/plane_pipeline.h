@@ -80,6 +80,7 @@ struct PipelineResult {
   std::string status;                // for people: "waiting for target", ...
   bool was_reset = false;            // time went backwards: everything started again
   bool tracking_loss = false;        // the pause since the last image exceeded max_gap_s
+  double pause_s = 0;                // with tracking_loss: that pause, s
   std::optional<PoseEstimate> pose;  // this image's camera in the map
   std::vector<ImagePlane> planes;    // largest first
   double reference_stamp = -1;       // image the homographies start from, -1 none
