@@ -162,6 +162,7 @@ int main(int argc, char** argv) {
     std::vector<cv::Vec3d> path_truth, path_estimate;  // world frame
     std::vector<cv::Vec3d> est_map, truth_map;          // posed images: estimate, truth
     int first_posed = -1;
+    double start_error_deg = -1;  // the first posed image's orientation against the truth
     int posed = 0, tracking = 0;
     cv::Vec3d last_position;
     for (int k = 0; k < frames; ++k) {
@@ -195,7 +196,11 @@ int main(int argc, char** argv) {
       last_position = truth_pose.t;
       double frame_err = -1;
       if (result.pose) {
-        if (first_posed < 0) first_posed = k;
+        if (first_posed < 0) {
+          first_posed = k;
+          const double c = (cv::trace(result.pose->map_from_camera.R * truth_pose.R.t()) - 1) / 2;
+          start_error_deg = std::acos(std::max(-1.0, std::min(1.0, c))) * 180 / CV_PI;
+        }
         est_map.push_back(result.pose->map_from_camera.t);
         truth_map.push_back(truth_pose.t);
       }
@@ -242,6 +247,9 @@ int main(int argc, char** argv) {
                   c.refused, c.refused ? " (last: " : "",
                   c.refused ? (c.last_reason + ")").c_str() : "", c.behind_after, c.refused_behind);
     }
+    // (camera_height's map has its own heading: its start is not compared.)
+    if (first_posed >= 0 && !floor_start)
+      std::printf("start: image %d, camera orientation %.2f deg off\n", first_posed, start_error_deg);
     if (loop + 1 < loops) continue;
     // camera_height's map has its own origin and heading: the rigid motion that best
     // aligns the camera paths (as the rostest judges it), its up judged on its own.
