@@ -57,7 +57,10 @@ int main(int argc, char** argv) {
   cli::Parser cli(
       "run_pipeline", "[options]",
       "  Renders a room seen from a moving camera and runs tracker + planes + map on it,\n"
-      "  then prints each mapped plane against the ground truth and the camera path error.",
+      "  then prints each mapped plane against the ground truth and the camera path error,\n"
+      "  and how far off the metric start put the camera's orientation (the tilt the map\n"
+      "  inherits from the start-up target; not with camera_height, whose map has its own\n"
+      "  heading).",
       "exit codes: 0 every true plane mapped once, 1 a plane missed or split, 2 bad usage\n");
   RoomParams room;
   std::string textures, save_dir, top_view;
