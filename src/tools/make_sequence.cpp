@@ -8,14 +8,11 @@
 
 #include "../sim/bag/sequence_writer.h"
 #include "cli_args.h"
+#include "mono_plane_detection/sim/scene_renderer.h"
 
 using namespace mono_plane_detection;
 
 namespace {
-
-// Rays precomputed per sub-pixel (3 doubles each) bound the renderer's memory: 2^24
-// sub-pixels, 4096 x 4096 at --supersample 1, are about 400 MB.
-constexpr long long kMaxSubpixels = 1LL << 24;
 
 // Where a path leads, following symbolic links even to a file that does not exist yet.
 std::filesystem::path resolved(const std::string& text) {
@@ -117,9 +114,9 @@ int main(int argc, char** argv) {
   const long long subpixels = static_cast<long long>(spec.camera.size.width) *
                               spec.camera.size.height * spec.render.supersample *
                               spec.render.supersample;
-  if (subpixels > kMaxSubpixels)
+  if (subpixels > kMaxRenderSubpixels)
     return cli.fail("width x height x supersample^2 = " + std::to_string(subpixels) +
-                    " sub-pixels, more than the limit " + std::to_string(kMaxSubpixels));
+                    " sub-pixels, more than the limit " + std::to_string(kMaxRenderSubpixels));
   spec.camera.cx = (spec.camera.size.width - 1) / 2.0;
   spec.camera.cy = (spec.camera.size.height - 1) / 2.0;
   if (yaml_path.empty()) {

@@ -74,6 +74,9 @@ int main(int argc, char** argv) {
       .integer("frames", &frames, 1, 1000000, "images per loop")
       .number("fps", &fps, 0.1, 1000.0, "images per second", "F")
       .number("noise", &render.noise_sigma, 0.0, 255.0, "image noise sigma, grey levels", "SIGMA")
+      .integer("supersample", &render.supersample, 1, 8,
+               "rays per pixel side (anti-aliasing; width x height x supersample^2 at most "
+               "2^24)")
       .integer<unsigned>("seed", &seed, 0, std::numeric_limits<unsigned>::max(),
                          "room textures and humanoid jerks", "S")
       .integer<long>("noise-seed", &noise_seed, -1, std::numeric_limits<unsigned>::max(),
@@ -103,6 +106,12 @@ int main(int argc, char** argv) {
                "run the sequence N times (soak: the map is reset at each loop, as a bag loop "
                "does; prints resident memory and time per frame per loop)");
   if (const auto code = cli.parse(argc, argv)) return *code;
+  const long long subpixels = static_cast<long long>(camera.size.width) * camera.size.height *
+                              render.supersample * render.supersample;
+  if (subpixels > kMaxRenderSubpixels)
+    return cli.fail("width x height x supersample^2 = " + std::to_string(subpixels) +
+                    " sub-pixels, more than the renderer's limit " +
+                    std::to_string(kMaxRenderSubpixels));
   // Keep the focal length's field of view when the size changes.
   camera.fx = camera.fy = 525.0 * camera.size.width / 640.0;
   camera.cx = (camera.size.width - 1) / 2.0;

@@ -79,6 +79,14 @@ TEST(ToolsCli, RunPipelineRefusesZeroFrames) {
   EXPECT_EQ(run(RUN_PIPELINE_PATH, "--seed -1").code, 2);
 }
 
+// The renderer's memory is bounded as make_sequence bounds it: width x height x
+// supersample^2 at most kMaxRenderSubpixels, refused before anything is rendered.
+TEST(ToolsCli, RunPipelineRefusesMoreSubpixelsThanTheRendererHolds) {
+  const ProgramRun r = run(RUN_PIPELINE_PATH, "--width 4096 --height 4096 --supersample 2");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_NE(r.err.find("sub-pixels"), std::string::npos) << r.err;
+}
+
 // docs/tools.md is every tool's --help, so the page cannot drift from the option tables.
 // Regenerate: MPD_WRITE_TOOLS_DOC=1 devel/lib/mono_plane_detection/test_tools_cli
 TEST(ToolsCli, DocsToolsPageIsEveryToolsHelp) {

@@ -10,6 +10,11 @@
 
 namespace mono_plane_detection {
 
+// Rays precomputed per sub-pixel (3 floats each, and the image's floats) bound the
+// renderer's memory: at most this many sub-pixels (width x height x supersample^2), 4096 x
+// 4096 at supersample 1. The tools refuse more.
+constexpr long long kMaxRenderSubpixels = 1LL << 24;
+
 struct RenderOptions {
   int supersample = 1;        // rays per pixel side (anti-aliasing): 2 = 4 rays per pixel
   int blur_subframes = 1;     // motion blur: average of this many poses (renderBlurred)
