@@ -65,8 +65,12 @@ rosrun mono_plane_detection demo_report planes:=/$camera/planes tracks:=/$camera
   image_planes:=/$camera/image_planes \
   image:="$image_topic" "${report_args[@]}" &
 report=$!
+# A generated bag (its ground truth known): its true camera joins the map frame's tree.
+ground_truth=false
+[ -z "$truth" ] || ground_truth=true
 roslaunch -p "$port" mono_plane_detection replay.launch bag:="$bag" profile:="$profile" \
-  camera:="$camera" image:="$image" rviz:="$rviz" player_required:=false > "$log" 2>&1 &
+  camera:="$camera" image:="$image" rviz:="$rviz" ground_truth:="$ground_truth" \
+  player_required:=false > "$log" 2>&1 &
 launch=$!
 trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
 wait $report || status=$?

@@ -5,11 +5,15 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <cstdlib>
 #include <thread>
 
 #include "../../src/sim/bag/sequence_writer.h"
+#include "mono_plane_detection/ros/map_frame.h"
+#include "mono_plane_detection/ros/pose_msg.h"
 #include "support/test_timeouts.h"
 #include "support/temp_path.h"
 
@@ -36,6 +40,8 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
       "/camera/camera_info", 100, [&](const sensor_msgs::CameraInfoConstPtr&) { ++infos; });
   ros::Subscriber tf = nh.subscribe<tf2_msgs::TFMessage>(
       "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr&) { ++tfs; });
+  tf2_ros::Buffer buffer(ros::Duration(100));
+  tf2_ros::TransformListener listener(buffer);
 
   // -d 2: rosbag play waits after advertising so that the subscribers connect.
   std::thread player([&] { EXPECT_EQ(std::system(("rosbag play -q -d 2 " + bag).c_str()), 0); });
@@ -47,6 +53,17 @@ TEST(SequencePlayback, RosbagPlayDeliversEverything) {
     EXPECT_NEAR(image_stamps[k], 1000.0 + k / 30.0, 1e-6);
   EXPECT_EQ(infos, 30);
   EXPECT_EQ(tfs, 30);
+  // ground_truth_frame (sequence_playback.test) joins the bag's tree to plane_map: the
+  // last true camera, seen from plane_map, is the ground truth turned into z up.
+  const IndoorScene scene = makeRoom(spec.room);
+  const Pose expected = rosMapFromTarget() * groundTruthPose(spec, scene, 29);
+  geometry_msgs::TransformStamped seen;
+  ASSERT_NO_THROW(seen = buffer.lookupTransform("plane_map", "camera_gt",
+                                                ros::Time(1000.0 + 29 / 30.0), ros::Duration(5)));
+  const Pose got = fromTransformMsg(seen.transform);
+  EXPECT_LT(cv::norm(got.t - expected.t), 1e-6);
+  EXPECT_LT(cv::norm(cv::Mat(got.R - expected.R)), 1e-6);
+  EXPECT_LT(got.t[0], -1.0) << "in front of the target's wall: plane_map's x points into it";
 }
 
 int main(int argc, char** argv) {

@@ -24,7 +24,7 @@ const std::vector<std::pair<std::string, std::string>> kTools = {
     {"make_sequence", MAKE_SEQUENCE_PATH},         {"run_pipeline", RUN_PIPELINE_PATH},
     {"segment_planes", SEGMENT_PLANES_PATH},       {"benchmark_tracker_floor", BENCHMARK_TRACKER_FLOOR_PATH},
     {"eval_two_view", EVAL_TWO_VIEW_PATH},         {"plane_pair", PLANE_PAIR_PATH},
-    {"param_table", PARAM_TABLE_PATH}};
+    {"param_table", PARAM_TABLE_PATH},             {"ground_truth_frame", GROUND_TRUTH_FRAME_PATH}};
 
 // No master on port 1: a program that tried to reach one would wait; `timeout` ends it.
 ProgramRun run(const std::string& path, const std::string& args) {
