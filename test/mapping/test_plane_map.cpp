@@ -228,7 +228,9 @@ TEST(PlaneMap, TwoStripsOnParallelSurfacesAreNotOneTiltedPlane) {
   EXPECT_GT(tilt, 20.0);
   obs.sigma_m.assign(obs.points.size(), 0.003);
   PlaneMap map;
-  map.update({obs}, 1000);
+  // Refused (two surfaces): no plane at all, rather than one tilted through both.
+  EXPECT_EQ(map.update({obs}, 1000)[0], -1);
+  EXPECT_TRUE(map.planes().empty());
   for (const MapPlane& p : map.planes())
     EXPECT_LT(normalAngleDeg(p.normal, cv::Vec3d(1, 0, 0)), 10.0) << "plane " << p.id;
 }

@@ -25,15 +25,18 @@ TEST(CrossRatio, InvariantUnderRandomHomographies) {
   ASSERT_TRUE(base);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int checked = 0;
   for (int trial = 0; trial < 200; ++trial) {
     const cv::Matx33d H(1 + 0.3 * u(rng), 0.3 * u(rng), 200 * u(rng), 0.3 * u(rng),
                         1 + 0.3 * u(rng), 200 * u(rng), 1e-3 * u(rng), 1e-3 * u(rng), 1.0);
     const auto other = fivePointInvariants(mapped(H, kFive), 1e-3);
     if (!other) continue;  // a homography can squash a triple nearly flat
+    ++checked;
     EXPECT_NEAR(other->i1, base->i1, 1e-6 * std::abs(base->i1));
     EXPECT_NEAR(other->i2, base->i2, 1e-6 * std::abs(base->i2));
     EXPECT_LT(invariantDistance(*base, *other), 1e-6);
   }
+  EXPECT_GT(checked, 150);  // a few squashed triples, not all
 }
 
 TEST(CrossRatio, PointMovedOffThePlaneChangesThem) {

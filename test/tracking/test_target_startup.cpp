@@ -137,6 +137,7 @@ TEST(TargetStartup, LensDistortionIsUndoneBeforeTheSidesAreFitted) {
   // Measured (k1 -0.30, k2 0.08, fx 525): raw 0.19-0.31 px where found, not found at
   // +-24 deg (bent sides fail the checks); with the lens 0.09-0.14 px, found in all.
   EXPECT_EQ(views, 5);
+  EXPECT_GT(worst_raw, 0);  // found raw in some views: the comparison below has a side
   EXPECT_LT(worst_lens, 0.2);
   EXPECT_LT(worst_lens, worst_raw);
 }
