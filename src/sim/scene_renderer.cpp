@@ -26,6 +26,14 @@ float bilinear(const cv::Mat& texture, double x, double y) {
 
 }  // namespace
 
+std::string renderSizeError(const cv::Size& size, int supersample) {
+  const long long subpixels =
+      static_cast<long long>(size.width) * size.height * supersample * supersample;
+  if (subpixels <= kMaxRenderSubpixels) return "";
+  return "width x height x supersample^2 = " + std::to_string(subpixels) +
+         " sub-pixels, more than the renderer's limit " + std::to_string(kMaxRenderSubpixels);
+}
+
 SceneRenderer::SceneRenderer(const IndoorScene& scene, const CameraModel& camera,
                              const RenderOptions& options)
     : scene_(scene), camera_(camera), options_(options) {

@@ -111,12 +111,8 @@ int main(int argc, char** argv) {
     }
   }
   spec.camera.fy = spec.camera.fx;
-  const long long subpixels = static_cast<long long>(spec.camera.size.width) *
-                              spec.camera.size.height * spec.render.supersample *
-                              spec.render.supersample;
-  if (subpixels > kMaxRenderSubpixels)
-    return cli.fail("width x height x supersample^2 = " + std::to_string(subpixels) +
-                    " sub-pixels, more than the limit " + std::to_string(kMaxRenderSubpixels));
+  if (const std::string e = renderSizeError(spec.camera.size, spec.render.supersample); !e.empty())
+    return cli.fail(e);
   spec.camera.cx = (spec.camera.size.width - 1) / 2.0;
   spec.camera.cy = (spec.camera.size.height - 1) / 2.0;
   if (yaml_path.empty()) {

@@ -106,12 +106,8 @@ int main(int argc, char** argv) {
                "run the sequence N times (soak: the map is reset at each loop, as a bag loop "
                "does; prints resident memory and time per frame per loop)");
   if (const auto code = cli.parse(argc, argv)) return *code;
-  const long long subpixels = static_cast<long long>(camera.size.width) * camera.size.height *
-                              render.supersample * render.supersample;
-  if (subpixels > kMaxRenderSubpixels)
-    return cli.fail("width x height x supersample^2 = " + std::to_string(subpixels) +
-                    " sub-pixels, more than the renderer's limit " +
-                    std::to_string(kMaxRenderSubpixels));
+  if (const std::string e = renderSizeError(camera.size, render.supersample); !e.empty())
+    return cli.fail(e);
   // Keep the focal length's field of view when the size changes.
   camera.fx = camera.fy = 525.0 * camera.size.width / 640.0;
   camera.cx = (camera.size.width - 1) / 2.0;

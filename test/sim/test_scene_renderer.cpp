@@ -218,3 +218,11 @@ TEST(SceneRenderer, ArucoMarkerIsFoundWhereItsCornersAre) {
     }
   }
 }
+
+TEST(SceneRenderer, SizesBeyondItsMemoryBoundAreNamed) {
+  EXPECT_EQ(renderSizeError({4096, 4096}, 1), "");  // 2^24 sub-pixels: the limit itself
+  EXPECT_EQ(renderSizeError({320, 240}, 8), "");
+  const std::string e = renderSizeError({4096, 4096}, 2);
+  EXPECT_NE(e.find("67108864 sub-pixels"), std::string::npos) << e;
+  EXPECT_NE(renderSizeError({4097, 4096}, 1), "");
+}

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "mono_plane_detection/sim/camera_trajectory.h"
@@ -14,6 +15,9 @@ namespace mono_plane_detection {
 // renderer's memory: at most this many sub-pixels (width x height x supersample^2), 4096 x
 // 4096 at supersample 1. The tools refuse more.
 constexpr long long kMaxRenderSubpixels = 1LL << 24;
+// Why an image of this size cannot be rendered at this supersampling (more sub-pixels than
+// kMaxRenderSubpixels), or "" when it can.
+std::string renderSizeError(const cv::Size& size, int supersample);
 
 struct RenderOptions {
   int supersample = 1;        // rays per pixel side (anti-aliasing): 2 = 4 rays per pixel
