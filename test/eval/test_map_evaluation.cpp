@@ -12,7 +12,9 @@ TEST(MapEvaluation, TruthPlanesAreInTheTargetFrame) {
   const IndoorScene scene = makeRoom(RoomParams());
   const auto truth = truthPlanes(scene);
   ASSERT_EQ(truth.size(), scene.planes.size());
+  int checked = 0;
   for (const TruthPlane& t : truth) {
+    checked += t.name == "front_wall" || t.name == "floor";
     if (t.name == "front_wall") {  // the target's wall: map z, through the origin
       EXPECT_LT(normalAngleDeg(t.normal, {0, 0, 1}), 1e-6);
       EXPECT_NEAR(t.distance, 0, 1e-9);
@@ -22,6 +24,7 @@ TEST(MapEvaluation, TruthPlanesAreInTheTargetFrame) {
       EXPECT_NEAR(t.distance, -0.8, 1e-9);
     }
   }
+  EXPECT_EQ(checked, 2);
 }
 
 TEST(MapEvaluation, ImageSharesAtTheStart) {

@@ -82,8 +82,9 @@ TEST(CameraTrajectory, TurnInPlaceAndLookAroundTurnALotAndMoveLittle) {
       path += cv::norm(pose.t - last.t);
       const cv::Matx33d dR = last.R.t() * pose.R;
       turned += degrees(std::acos(std::min(1.0, (cv::trace(dR) - 1) / 2)));
-      // Orthonormal, optical axis never up.
+      // Orthonormal, optical axis never up (world z).
       EXPECT_LT(cv::norm(pose.R.t() * pose.R - cv::Matx33d::eye()), 1e-9);
+      EXPECT_LE(pose.R(2, 2), 0.0) << name << " image " << k;
       last = pose;
     }
     if (name == "turn_in_place") {

@@ -150,16 +150,19 @@ TEST(SceneRenderer, PlaneMovesAsItsHomographyPredicts) {
 
   // And by the known texture coordinates: points of the wall projected into both views
   // obey the same homography exactly.
+  int projected = 0;
   for (double wa = 1.0; wa < 5.0; wa += 0.5) {
     for (double wb = 0.3; wb < 2.0; wb += 0.4) {
       const cv::Vec3d X = wall.origin + wa * wall.u_axis + wb * wall.v_axis;
       const cv::Vec3d xa = a.inverse().apply(X), xb = b.inverse().apply(X);
       if (xa[2] <= 0 || xb[2] <= 0) continue;
+      ++projected;
       const cv::Point2d pa = f.camera.project(xa), pb = f.camera.project(xb);
       const cv::Vec3d q = H * cv::Vec3d(pa.x, pa.y, 1);
       EXPECT_LT(std::hypot(q[0] / q[2] - pb.x, q[1] / q[2] - pb.y), 1e-6);
     }
   }
+  EXPECT_GT(projected, 30);  // of the 40 wall points
 }
 
 TEST(SceneRenderer, SameSeedSameImageAndNoiseBlurExposureWork) {
@@ -178,8 +181,16 @@ TEST(SceneRenderer, SameSeedSameImageAndNoiseBlurExposureWork) {
   EXPECT_NEAR(mean[0], 3 * std::sqrt(2 / CV_PI), 0.3);  // mean |N(0, 3)|
   // Blur: the mean of renders along the path; exposure scales intensity.
   const cv::Mat one = clean.render(pose);
-  const cv::Mat blurred = clean.renderBlurred({pose, pose, pose});
-  EXPECT_EQ(cv::norm(one, blurred, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(one, clean.renderBlurred({pose, pose, pose}), cv::NORM_INF), 0.0);
+  const Pose later = trajectoryPose(f.trajectory, 0.6);
+  const cv::Mat other = clean.render(later), blurred = clean.renderBlurred({pose, later});
+  cv::Mat mean_of_two;
+  cv::addWeighted(one, 0.5, other, 0.5, 0, mean_of_two, CV_32F);
+  cv::Mat blurred_f;
+  blurred.convertTo(blurred_f, CV_32F);
+  EXPECT_LE(cv::norm(blurred_f, mean_of_two, cv::NORM_INF), 1.0);  // both poses, averaged
+  EXPECT_GT(cv::norm(blurred, one, cv::NORM_L1), 0.0);
+  EXPECT_GT(cv::norm(blurred, other, cv::NORM_L1), 0.0);
   RenderOptions dark;
   dark.exposure = 0.5;
   const cv::Mat half = SceneRenderer(f.scene, f.camera, dark).render(pose);

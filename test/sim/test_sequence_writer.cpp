@@ -94,12 +94,14 @@ TEST(SequenceWriter, GroundTruthYamlDescribesTheScene) {
   for (const auto& plane : gt["planes"]) {
     const auto n = plane["normal"].as<std::vector<double>>();
     EXPECT_NEAR(std::hypot(n[0], n[1], n[2]), 1.0, 1e-12);
+    ASSERT_GE(plane["polygon_map"].size(), 3u);
     for (const auto& corner : plane["polygon_map"]) {
       const auto c = corner.as<std::vector<double>>();
       EXPECT_NEAR(n[0] * c[0] + n[1] * c[1] + n[2] * c[2], plane["distance_m"].as<double>(), 1e-9);
     }
   }
   // The map frame is the target's: its corners at z = 0, the front wall through the origin.
+  ASSERT_EQ(gt["target"]["corners_map"].size(), 4u);
   for (const auto& corner : gt["target"]["corners_map"])
     EXPECT_NEAR(corner[2].as<double>(), 0.0, 1e-12);
   EXPECT_EQ(gt["planes"][1]["name"].as<std::string>(), "front_wall");
@@ -165,11 +167,15 @@ TEST(SequenceWriter, ColourEncodingAndBadSpecs) {
   spec.encoding = "bgr8";
   writeSequence(spec, temp("bgr.bag"), temp("bgr.yaml"));
   rosbag::Bag bag(temp("bgr.bag"));
+  int images = 0;
   for (const auto& m : rosbag::View(bag, rosbag::TopicQuery("/camera/image_raw"))) {
     const auto image = m.instantiate<sensor_msgs::Image>();
+    ASSERT_TRUE(image);
+    ++images;
     EXPECT_EQ(image->encoding, "bgr8");
     EXPECT_EQ(image->step, 640u * 3u);
   }
+  EXPECT_EQ(images, 2);
   spec.encoding = "rgb16";
   EXPECT_THROW(writeSequence(spec, temp("x.bag"), temp("x.yaml")), std::runtime_error);
   spec = shortSpec();

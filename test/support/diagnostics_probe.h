@@ -3,6 +3,7 @@
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <string>
@@ -27,8 +28,12 @@ class DiagnosticsProbe {
       if (kv.key == key) return kv.value;
     return "";
   }
+  // -1 when absent; a status that came without the key fails the test (a renamed key
+  // would make before/after comparisons of -1 with -1 pass).
   long number(const std::string& key) const {
     const std::string v = value(key);
+    if (v.empty() && !status_.values.empty())
+      ADD_FAILURE() << "no diagnostics key '" << key << "' in " << status_.name;
     return v.empty() ? -1 : std::stol(v);
   }
   int level() const { return status_.level; }

@@ -124,7 +124,7 @@ TEST(Profile, OneFileForBothNodeletsSetsEachNameWhereItIsKnown) {
       writeYaml("bad.yaml", "max_feature: 77\ntarget:\n  width_m: fast\n");
   const std::vector<std::string> errors = loadProfiles(
       dir, bad, "tracker", trackerNodeParamTable(), tracker, "planes", planeNodeParamTable(), planes);
-  ASSERT_EQ(errors.size(), 2u) << errors[0];
+  ASSERT_EQ(errors.size(), 2u) << (errors.empty() ? std::string("none") : errors[0]);
   EXPECT_NE(errors[0].find("unknown parameter max_feature (neither tracker nor planes"),
             std::string::npos)
       << errors[0];

@@ -30,6 +30,12 @@ TEST(DrawTracks, ColoursByState) {
 
 TEST(DrawTracks, ColourInputKeepsItsPixelsElsewhere) {
   const cv::Mat bgr(50, 50, CV_8UC3, cv::Scalar(10, 20, 30));
-  const cv::Mat out = drawTracks(bgr, {});
-  EXPECT_EQ(cv::norm(out, bgr, cv::NORM_INF), 0.0);
+  TrackedPoint p;
+  p.uv = {10, 10};
+  p.is_tracked = true;
+  const cv::Mat out = drawTracks(bgr, {p});
+  EXPECT_GT(cv::norm(out, bgr, cv::NORM_INF), 0.0);                 // the point is drawn ...
+  EXPECT_EQ(out.at<cv::Vec3b>(40, 40), cv::Vec3b(10, 20, 30));       // ... not elsewhere
+  const cv::Mat as_given(50, 50, CV_8UC3, cv::Scalar(10, 20, 30));
+  EXPECT_EQ(cv::norm(bgr, as_given, cv::NORM_INF), 0.0);  // the caller's image untouched
 }
