@@ -206,8 +206,7 @@ int main(int argc, char** argv) {
       if (result.pose) {
         if (first_posed < 0) {
           first_posed = k;
-          const double c = (cv::trace(result.pose->map_from_camera.R * truth_pose.R.t()) - 1) / 2;
-          start_error_deg = std::acos(std::max(-1.0, std::min(1.0, c))) * 180 / CV_PI;
+          start_error_deg = rotationAngleDeg(result.pose->map_from_camera.R * truth_pose.R.t());
         }
         est_map.push_back(result.pose->map_from_camera.t);
         truth_map.push_back(truth_pose.t);

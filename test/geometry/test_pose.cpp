@@ -23,5 +23,13 @@ TEST(Pose, ProductChainsFrames) {
   EXPECT_LT(cv::norm((aFromB() * b_from_c).apply(x) - aFromB().apply(b_from_c.apply(x))), 1e-12);
 }
 
+TEST(Pose, RotationAngleIsHowFarItTurns) {
+  EXPECT_NEAR(rotationAngleDeg(aFromB().R), 90.0, 1e-9);
+  EXPECT_NEAR(rotationAngleDeg(cv::Matx33d::eye()), 0.0, 1e-9);
+  EXPECT_NEAR(rotationAngleDeg(cv::Matx33d(1, 0, 0, 0, -1, 0, 0, 0, -1)), 180.0, 1e-9);
+  // Rounding past +-1 in the trace is no NaN.
+  EXPECT_NEAR(rotationAngleDeg(cv::Matx33d::eye() * (1 + 1e-12)), 0.0, 1e-3);
+}
+
 }  // namespace
 }  // namespace mono_plane_detection

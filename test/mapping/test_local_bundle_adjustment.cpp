@@ -23,11 +23,6 @@ cv::Matx33d rotationAbout(const cv::Vec3d& axis, double deg) {
   return cv::Matx33d::eye() + s * K + (1 - c) * K * K;
 }
 
-double angleDeg(const cv::Matx33d& R) {
-  const double c = std::max(-1.0, std::min(1.0, (cv::trace(R) - 1) / 2));
-  return std::acos(c) * 180 / CV_PI;
-}
-
 // A camera walking 1 m along x, 2-3 m in front of a wall (z = 3) and above a floor
 // (y = 1.2 below, y down in the camera), looking along +z and turning slowly.
 struct Scene {
@@ -92,7 +87,7 @@ Errors errorsOf(const Scene& s) {
   for (size_t i = 0; i < s.truth_views.size(); ++i) {
     const Pose& p = s.problem.views[i].map_from_camera;
     e.position_m = std::max(e.position_m, cv::norm(p.t - s.truth_views[i].t));
-    e.angle_deg = std::max(e.angle_deg, angleDeg(p.R.t() * s.truth_views[i].R));
+    e.angle_deg = std::max(e.angle_deg, rotationAngleDeg(p.R.t() * s.truth_views[i].R));
   }
   // Points seen from two views or more (one view leaves a point free along its ray).
   std::vector<int> seen(s.truth_points.size(), 0);

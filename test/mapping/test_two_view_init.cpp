@@ -87,8 +87,7 @@ TEST(TwoViewInit, RefusesTooFewPoints) {
 namespace {
 
 double angleBetweenDeg(const cv::Matx33d& a, const cv::Matx33d& b) {
-  const cv::Matx33d d = a * b.t();
-  return std::acos(std::max(-1.0, std::min(1.0, (cv::trace(d) - 1) / 2))) * 180.0 / CV_PI;
+  return rotationAngleDeg(a * b.t());
 }
 
 // The pose from four normalised corners, solved in pixels of camera K (as the pipeline).

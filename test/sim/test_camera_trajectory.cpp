@@ -81,7 +81,7 @@ TEST(CameraTrajectory, TurnInPlaceAndLookAroundTurnALotAndMoveLittle) {
       const Pose pose = trajectoryPose(p, k / 30.0);
       path += cv::norm(pose.t - last.t);
       const cv::Matx33d dR = last.R.t() * pose.R;
-      turned += degrees(std::acos(std::min(1.0, (cv::trace(dR) - 1) / 2)));
+      turned += rotationAngleDeg(dR);
       // Orthonormal, optical axis never up (world z).
       EXPECT_LT(cv::norm(pose.R.t() * pose.R - cv::Matx33d::eye()), 1e-9);
       EXPECT_LE(pose.R(2, 2), 0.0) << name << " image " << k;

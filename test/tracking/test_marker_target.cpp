@@ -119,7 +119,7 @@ TEST(MarkerTarget, PoseInTheMapFrame) {
   ASSERT_TRUE(pose);
   EXPECT_LT(cv::norm(pose->map_from_camera.t - position), 0.01);  // 1 cm at 0.75 m
   const cv::Matx33d dR = pose->map_from_camera.R.t() * v.map_from_camera.R;
-  EXPECT_LT(std::acos(std::min(1.0, (cv::trace(dR) - 1) / 2)) * 180 / CV_PI, 1.0);
+  EXPECT_LT(rotationAngleDeg(dR), 1.0);
   const auto map = targetCornersInMap(p);
   EXPECT_DOUBLE_EQ(map[2].x - map[0].x, 0.15);
   EXPECT_DOUBLE_EQ(map[2].y - map[0].y, 0.15);

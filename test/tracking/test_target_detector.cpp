@@ -58,7 +58,7 @@ double cornerError(const View& v, const TargetDetection& d) {
 std::pair<double, double> poseError(const View& v, const TargetPose& p) {
   const Pose truth = v.scene.target.world_from_map.inverse() * v.world_from_camera;
   const cv::Matx33d dR = truth.R.t() * p.map_from_camera.R;
-  const double angle = std::acos(std::min(1.0, (cv::trace(dR) - 1) / 2)) * 180 / CV_PI;
+  const double angle = rotationAngleDeg(dR);
   return {cv::norm(truth.t - p.map_from_camera.t), angle};
 }
 

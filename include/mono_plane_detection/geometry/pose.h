@@ -2,6 +2,8 @@
 // in frame b to frame a. ROS-free.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <opencv2/core.hpp>
 
 namespace mono_plane_detection {
@@ -14,5 +16,11 @@ struct Pose {
   Pose inverse() const { return {R.t(), -(R.t() * t)}; }
   Pose operator*(const Pose& o) const { return {R * o.R, R * o.t + t}; }
 };
+
+// The angle (deg) a rotation turns by, from its trace; of a * b.t() it is how far the
+// rotations a and b are apart.
+inline double rotationAngleDeg(const cv::Matx33d& R) {
+  return std::acos(std::max(-1.0, std::min(1.0, (cv::trace(R) - 1) / 2))) * 180.0 / CV_PI;
+}
 
 }  // namespace mono_plane_detection
