@@ -157,6 +157,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     if (pending_.size() > 1000) pending_.pop_front();
   }
   if (result.pose && pose_->scaleKnown()) {
+    map_.setUpIsVertical(pose_->metricSource() != MetricSource::kCameraHeight);
     for (PendingView& v : pending_) {
       v.pose.map_from_camera = pose_->floorCorrectionApplied().apply(v.pose.map_from_camera);
       map_.update(observationsOf(v.planes, v.pose), v.stamp);

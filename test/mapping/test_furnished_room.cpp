@@ -180,7 +180,8 @@ TEST(FurnishedRoom, HumanoidPath) {
   // The floor (25 points in 7 views, the least supported plane) moves by centimetres with
   // the start: 0.003 m with the start's corners averaged, 0.022 m with its orientations;
   // 0.029 m held to the room's right angles (map/structure_sigmas: its strip leans with
-  // the left wall and shelf front it is held to; 0.025 m without).
+  // the left wall and shelf front it is held to; 0.025 m without); 0.023 m held level by
+  // the map's up too (map/up_sigma_deg).
   EXPECT_LT(run.eval.worst_distance_error_m, 0.03);
   EXPECT_GE(run.posed, 250);
   // 0.5 % before the sheet was re-detected, 0.3-0.6 % since (with the search region's

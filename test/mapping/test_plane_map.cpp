@@ -438,6 +438,76 @@ TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
   EXPECT_GT(free_sum / 10, 2 * held_sum / 10);  // the strip alone is worse: a real test
 }
 
+// The map's up (map/up_sigma_deg): the same strip of floor with no wall in the map is held
+// level by the map's +y once the map is told its up is the room's vertical (the target's or
+// the odometry's up), and keeps its own tilt when it is not (camera_height, or not told) or
+// when up_sigma_deg is 0. Its confirmation stays its own points'.
+TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
+  double held_sum = 0, free_sum = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    MapParams no_up;
+    no_up.up_sigma_deg = 0;
+    PlaneMap held, untold, off(no_up);
+    held.setUpIsVertical(true);
+    off.setUpIsVertical(true);
+    std::mt19937 rng(seed);
+    for (int k = 0; k < 8; ++k) {
+      const std::vector<PlaneObservation> image = {floorStrip(rng, k, 20, -2.95, -2.65, 0.006)};
+      held.update(image, 1000 + 0.1 * k);
+      untold.update(image, 1000 + 0.1 * k);
+      off.update(image, 1000 + 0.1 * k);
+    }
+    ASSERT_EQ(held.planes().size(), 1u) << seed;
+    ASSERT_EQ(untold.planes().size(), 1u) << seed;
+    ASSERT_EQ(off.planes().size(), 1u) << seed;
+    const MapPlane& with = held.planes()[0];
+    const MapPlane& without = untold.planes()[0];
+    ASSERT_LE(without.normal_sigma_deg, held.params().max_normal_sigma_deg) << seed;
+    // Not told, or told with up_sigma_deg 0: the points' own plane.
+    EXPECT_LT(normalAngleDeg(without.normal, without.own_normal), 1e-12) << seed;
+    EXPECT_LT(normalAngleDeg(off.planes()[0].normal, without.normal), 1e-12) << seed;
+    EXPECT_LT(normalAngleDeg(with.own_normal, without.normal), 1e-9) << seed;
+    EXPECT_EQ(with.normal_sigma_deg, without.normal_sigma_deg);
+    EXPECT_EQ(with.confirmed(held.params()), without.confirmed(untold.params()));
+    EXPECT_LT(normalAngleDeg(with.normal, kFloor), normalAngleDeg(without.normal, kFloor)) << seed;
+    held_sum += normalAngleDeg(with.normal, kFloor);
+    free_sum += normalAngleDeg(without.normal, kFloor);
+  }
+  std::printf("floor strip: alone %.2f deg, held by the map's up %.2f deg (mean of 10 draws)\n",
+              free_sum / 10, held_sum / 10);
+  EXPECT_GT(free_sum / 10, 2 * held_sum / 10);
+  // A reset map waits to be told again.
+  PlaneMap map;
+  map.setUpIsVertical(true);
+  map.reset();
+  std::mt19937 rng(3);
+  for (int k = 0; k < 8; ++k) map.update({floorStrip(rng, k, 20, -2.95, -2.65, 0.006)}, 1000 + 0.1 * k);
+  ASSERT_EQ(map.planes().size(), 1u);
+  EXPECT_LT(normalAngleDeg(map.planes()[0].normal, map.planes()[0].own_normal), 1e-12);
+}
+
+// A ramp is not a floor: 2 m x 2 m of it, tilted 5 deg about x, points 1 cm off, fixes its
+// normal to about a tenth of a degree, and the map's up (0.2 deg, or even 0.01) does not pull
+// it level: the points reject the relation (map/structure_sigmas).
+TEST(PlaneMap, ARampKeepsItsSlopeUnderTheMapsUp) {
+  const double tilt = 5 * CV_PI / 180;
+  const cv::Vec3d ramp(0, std::cos(tilt), std::sin(tilt));
+  for (double up_sigma : {0.2, 0.01}) {
+    MapParams params;
+    params.up_sigma_deg = up_sigma;
+    PlaneMap map(params);
+    map.setUpIsVertical(true);
+    for (int k = 0; k < 6; ++k) {
+      map.update({observe(ramp, -0.5, 100 + 40 * k, 40, k + 1, 1.0)}, 1000 + 0.1 * k);
+    }
+    ASSERT_EQ(map.planes().size(), 1u) << up_sigma;
+    const MapPlane& plane = map.planes()[0];
+    ASSERT_TRUE(plane.confirmed(map.params())) << up_sigma;
+    EXPECT_NEAR(normalAngleDeg(plane.normal, kFloor), 5.0, 0.3) << up_sigma;
+    EXPECT_LT(normalAngleDeg(plane.normal, plane.own_normal), 1e-9) << up_sigma;
+  }
+}
+
 // A plane its own points leave loose (over max_normal_sigma_deg) is not held: it would
 // swing to a reference by degrees.
 TEST(PlaneMap, ALooseStripIsNotHeld) {

@@ -42,6 +42,13 @@ struct MapParams {
   // to (or parallel to) better-known confirmed planes while its points do not reject that
   // at this many of their standard deviations (mapping/structure_fit.h); 0: off.
   double structure_sigmas = 3.0;
+  // How far the map's up (the core's +y: the start-up target's vertical edge, or the
+  // odometry frame's z) may be from the room's vertical, 1 sigma (deg). Floors, ceilings
+  // and walls are held level or upright by it as by a confirmed plane, while their points
+  // allow (structure_sigmas). 0.2: a target hung with a spirit level (1 mm over an A4
+  // sheet's long edge); hung by eye, 0.5-1; 0: off. Not with camera_height, whose up is its
+  // own floor's first fit (a map plane already).
+  double up_sigma_deg = 0.2;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
@@ -107,6 +114,9 @@ class PlaneMap {
 
   const std::vector<MapPlane>& planes() const { return planes_; }
   const MapParams& params() const { return params_; }
+  // Whether the map's +y is the room's vertical to within MapParams::up_sigma_deg (the
+  // target's or the odometry's up; not the floor fit of camera_height). Off until set.
+  void setUpIsVertical(bool vertical) { up_is_vertical_ = vertical; }
   void reset();
 
  private:
@@ -125,6 +135,7 @@ class PlaneMap {
   MapParams params_;
   std::vector<MapPlane> planes_;
   int next_id_ = 1;
+  bool up_is_vertical_ = false;
 };
 
 }  // namespace mono_plane_detection
