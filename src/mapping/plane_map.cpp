@@ -216,7 +216,7 @@ PlaneFit PlaneMap::fitObservation(const PlaneObservation& obs, int needed) const
 void PlaneMap::reset() {
   planes_.clear();
   next_id_ = 1;
-  up_is_vertical_ = false;
+  vertical_.reset();
 }
 
 std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observations, double stamp) {
@@ -400,15 +400,17 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
   // association gate. The references' own planes, not their held ones: none is pulled back
   // by its own earlier pull through another.
   std::vector<ReferencePlane> references;
-  if (points_sigma_deg <= params_.max_normal_sigma_deg)
+  const bool holdable = points_sigma_deg <= params_.max_normal_sigma_deg;
+  if (holdable)
     for (const MapPlane& other : planes_)
       if (other.id != plane.id && other.id != merged && other.confirmed(params_) &&
           other.normal_sigma_deg < plane.normal_sigma_deg)
         references.push_back({other.own_normal, other.normal_sigma_deg});
-  // The map's up, as a horizontal plane known to up_sigma_deg: a floor level, a wall upright.
-  if (points_sigma_deg <= params_.max_normal_sigma_deg && up_is_vertical_ &&
-      params_.up_sigma_deg > 0)
-    references.push_back({cv::Vec3d(0, 1, 0), params_.up_sigma_deg});
+  // The room's vertical, as a horizontal plane known to up_sigma_deg, offered as the planes
+  // are (to one known worse): a floor level, a wall upright.
+  if (holdable && vertical_ && params_.up_sigma_deg > 0 &&
+      params_.up_sigma_deg < plane.normal_sigma_deg)
+    references.push_back({*vertical_, params_.up_sigma_deg});
   if (!references.empty()) {
     const StructuredPlane held = structuredPlane(inliers, fit.normal, references,
                                                  params_.structure_sigmas, params_.min_residual_m);

@@ -12,6 +12,11 @@
 namespace mono_plane_detection {
 namespace {
 
+// A camera whose image up is within this of the map's +y at the map's first placed image
+// stands upright along it (robot cameras are mounted upright, pitched less than this); a
+// sheet on the floor seen by such a camera is 90 deg - its pitch away.
+constexpr double kUprightCameraMaxDeg = 45.0;
+
 double jaccard(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
   const std::unordered_set<std::uint64_t> in_a(a.begin(), a.end());
   size_t both = 0;
@@ -62,6 +67,7 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   distortion_ = d;
   pose_.emplace(K_, distortion_, params_.pose, params_.target);
   map_.reset();
+  vertical_decided_ = false;
   pending_.clear();
   history_.clear();
   previous_planes_.clear();
@@ -79,6 +85,7 @@ void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap,
 void PlanePipeline::reset() {
   if (pose_) pose_->reset();
   map_.reset();
+  vertical_decided_ = false;
   pending_.clear();
   history_.clear();
   stream_.reset();
@@ -157,7 +164,18 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     if (pending_.size() > 1000) pending_.pop_front();
   }
   if (result.pose && pose_->scaleKnown()) {
-    map_.setUpIsVertical(pose_->metricSource() != MetricSource::kCameraHeight);
+    // The map's +y is the room's vertical (the target upright on a wall, the odometry's z)
+    // when the camera of the map's first placed image stood upright along it: a sheet on
+    // the floor or hung portrait, or an odometry frame whose z is not up, is not. Not with
+    // camera_height: its up is its own floor's first fit, a map plane already.
+    if (!vertical_decided_) {
+      vertical_decided_ = true;
+      const cv::Vec3d up(0, 1, 0);
+      const bool upright =
+          pose_->metricSource() != MetricSource::kCameraHeight &&
+          cameraUpAngleDeg(result.pose->map_from_camera, up) <= kUprightCameraMaxDeg;
+      map_.setVertical(upright ? std::optional<cv::Vec3d>(up) : std::nullopt);
+    }
     for (PendingView& v : pending_) {
       v.pose.map_from_camera = pose_->floorCorrectionApplied().apply(v.pose.map_from_camera);
       map_.update(observationsOf(v.planes, v.pose), v.stamp);

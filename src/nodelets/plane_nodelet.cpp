@@ -64,6 +64,12 @@ std::string secondsText(double s) {
   return text.str();
 }
 
+std::string degreesText(double deg) {
+  std::ostringstream text;
+  text << deg << " deg";
+  return text.str();
+}
+
 }  // namespace
 
 class PlaneNodelet : public nodelet::Nodelet {
@@ -875,6 +881,17 @@ class PlaneNodelet : public nodelet::Nodelet {
                                            : tf_edge_);
     status.add("metric source", metric_source_.empty() ? "none yet (" + node_.pipeline.pose.metric_source + ")"
                                                        : metric_source_);
+    // Whether loose floors and walls are held level / upright by the map's up (mapping.md,
+    // rule 7): a user whose sheet lies on the floor sees why not.
+    status.add("map up (map/up_sigma_deg)",
+               params_.map.up_sigma_deg <= 0   ? std::string("off")
+               : metric_source_.empty()        ? std::string("no metric map yet")
+               : pipeline_->map().vertical()   ? "held to it (" + degreesText(params_.map.up_sigma_deg) + ")"
+               : metric_source_ == "camera_height"
+                   ? std::string("not used: the map's up is the floor's own fit")
+                   : std::string("not used: the camera at the map's start was not upright along "
+                                 "the target's y (a target on the floor or portrait?) or the "
+                                 "odometry's z"));
     status.add("tracks with camera_info of another size (total)", info_size_mismatch_);
     status.add("tracks with camera_info of another frame_id (total)", info_frame_mismatch_);
     // Every start over of the map: ~reset calls and time going backwards (a bag loop).

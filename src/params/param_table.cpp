@@ -359,9 +359,10 @@ const ParamTable<MapParams>& mapParamTable() {
        "a plane is held at right angles to or parallel to better-known confirmed planes "
        "while its points do not reject that at this many standard deviations (0: off)"},
       {"up_sigma_deg", field(&P::up_sigma_deg), 0, 10, "deg",
-       "how far the map's up (the target's vertical edge, the odometry's z) may be from the "
-       "room's vertical, 1 sigma: floors and walls are held level or upright by it as by a "
-       "confirmed plane (0.2: target hung with a spirit level; by eye 0.5-1; 0: off)"},
+       "how far the map's up (the target's y hung landscape on a wall, the odometry's z; "
+       "taken when the map's first camera stands upright along it) may be from the room's "
+       "vertical, 1 sigma: planes known worse are held level or upright by it while their "
+       "points allow (0.2: target hung with a spirit level; by eye 0.5-1; 0: off)"},
       {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",
        "unconfirmed planes unseen for this long are removed", "tentative_timeout_s"},
       {"fade_time_s", field(&P::fade_time_s), 1e-3, 1e6, "s",

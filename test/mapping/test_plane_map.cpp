@@ -439,7 +439,7 @@ TEST(PlaneMap, AStripOfFloorIsHeldAtRightAnglesToTheConfirmedWalls) {
 }
 
 // The map's up (map/up_sigma_deg): the same strip of floor with no wall in the map is held
-// level by the map's +y once the map is told its up is the room's vertical (the target's or
+// level once the map is told the room's vertical (PlaneMap::setVertical: the target's or
 // the odometry's up), and keeps its own tilt when it is not (camera_height, or not told) or
 // when up_sigma_deg is 0. Its confirmation stays its own points'.
 TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
@@ -448,8 +448,8 @@ TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
     MapParams no_up;
     no_up.up_sigma_deg = 0;
     PlaneMap held, untold, off(no_up);
-    held.setUpIsVertical(true);
-    off.setUpIsVertical(true);
+    held.setVertical(kFloor);
+    off.setVertical(kFloor);
     std::mt19937 rng(seed);
     for (int k = 0; k < 8; ++k) {
       const std::vector<PlaneObservation> image = {floorStrip(rng, k, 20, -2.95, -2.65, 0.006)};
@@ -478,8 +478,10 @@ TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
   EXPECT_GT(free_sum / 10, 2 * held_sum / 10);
   // A reset map waits to be told again.
   PlaneMap map;
-  map.setUpIsVertical(true);
+  map.setVertical(kFloor);
+  ASSERT_TRUE(map.vertical());
   map.reset();
+  EXPECT_FALSE(map.vertical());
   std::mt19937 rng(3);
   for (int k = 0; k < 8; ++k) map.update({floorStrip(rng, k, 20, -2.95, -2.65, 0.006)}, 1000 + 0.1 * k);
   ASSERT_EQ(map.planes().size(), 1u);
@@ -487,8 +489,9 @@ TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
 }
 
 // A ramp is not a floor: 2 m x 2 m of it, tilted 5 deg about x, points 1 cm off, fixes its
-// normal to about a tenth of a degree, and the map's up (0.2 deg, or even 0.01) does not pull
-// it level: the points reject the relation (map/structure_sigmas).
+// normal to about a tenth of a degree, and the map's up does not pull it level: at 0.2 deg
+// it is known worse than the ramp and not offered (as a plane is not); at 0.01 the points
+// reject the relation (map/structure_sigmas).
 TEST(PlaneMap, ARampKeepsItsSlopeUnderTheMapsUp) {
   const double tilt = 5 * CV_PI / 180;
   const cv::Vec3d ramp(0, std::cos(tilt), std::sin(tilt));
@@ -496,7 +499,7 @@ TEST(PlaneMap, ARampKeepsItsSlopeUnderTheMapsUp) {
     MapParams params;
     params.up_sigma_deg = up_sigma;
     PlaneMap map(params);
-    map.setUpIsVertical(true);
+    map.setVertical(kFloor);
     for (int k = 0; k < 6; ++k) {
       map.update({observe(ramp, -0.5, 100 + 40 * k, 40, k + 1, 1.0)}, 1000 + 0.1 * k);
     }

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "mono_plane_detection/eval/map_evaluation.h"
+#include "mono_plane_detection/geometry/plane_fit.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "support/synthetic_tracks.h"
 
@@ -52,6 +53,35 @@ TEST(PlanePipeline, MapsTheRoomsPlanesInMetres) {
   // and 4.3 cm.
   EXPECT_LT(e.worst_normal_error_deg, 5.0);
   EXPECT_LT(e.worst_distance_error_m, 0.10);
+  // The sheet upright on the wall, the camera upright: the map's +y is the room's vertical.
+  ASSERT_TRUE(pipeline.map().vertical());
+  EXPECT_LT(normalAngleDeg(*pipeline.map().vertical(), cv::Vec3d(0, 1, 0)), 1e-12);
+}
+
+// The map's vertical (map/up_sigma_deg) is the map's +y only when the camera of its first
+// placed image stands upright along it: an odometry frame turned 90 deg (its y along the
+// camera's view, as a visual odometry whose frame is the first camera's) gives none; a
+// reset map decides again.
+TEST(PlanePipeline, TheMapsVerticalIsTakenOnlyFromAnUprightCamera) {
+  const SyntheticTracks world("wheeled");
+  const Pose turned{cv::Matx33d(1, 0, 0, 0, 0, -1, 0, 1, 0), {0, 0, 0}};  // 90 deg about x
+  for (bool upright : {true, false}) {
+    PipelineParams params;
+    params.pose.metric_source = "odometry";
+    PlanePipeline pipeline(params);
+    pipeline.setCamera(world.camera.K(), world.camera.distortion());
+    int placed = 0;
+    for (int k = 0; k < 10; ++k) {
+      const Pose truth = world.truthMapFromCamera(k / 30.0);
+      placed += pipeline.process(world.frame(k / 30.0), upright ? truth : turned * truth).pose.has_value();
+    }
+    ASSERT_GT(placed, 0) << upright;
+    EXPECT_EQ(pipeline.map().vertical().has_value(), upright);
+    pipeline.reset();
+    EXPECT_FALSE(pipeline.map().vertical());
+    pipeline.process(world.frame(1.0), upright ? world.truthMapFromCamera(1.0) : turned * world.truthMapFromCamera(1.0));
+    EXPECT_EQ(pipeline.map().vertical().has_value(), upright) << "after a reset";
+  }
 }
 
 TEST(PlanePipeline, ImageSpacePlanesWithoutIntrinsics) {
@@ -280,6 +310,7 @@ TEST(PlanePipeline, PlanesSeenWhileAnUnscaledStartIsCheckedAreMapped) {
   }
   ASSERT_GT(first_pose, 0) << "no metric start";
   EXPECT_FALSE(map_before_pose) << "nothing is mapped before the check";
+  EXPECT_FALSE(pipeline.map().vertical());  // its up is its own floor's first fit
   int earlier = 0;
   for (const MapPlane& p : pipeline.map().planes())
     earlier += p.confirmed(pipeline.map().params()) && p.first_seen < first_pose - 1.0;

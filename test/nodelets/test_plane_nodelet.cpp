@@ -224,6 +224,12 @@ TEST_F(PlaneNodeletTest, C_MetricPlanesOfTheRoom) {
   EXPECT_TRUE(last->metric);
   EXPECT_EQ(last->header.frame_id, "plane_map");
   EXPECT_EQ(last->status.rfind("tracking", 0), 0u) << last->status;
+  {
+    // The sheet upright on the wall, the camera upright: the map's up holds the planes.
+    DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+    ASSERT_TRUE(diagnostics.waitFresh());
+    EXPECT_EQ(diagnostics.value("map up (map/up_sigma_deg)"), "held to it (0.2 deg)");
+  }
   // REP 103, z up: the front wall (the target's: x = 0, normal towards the camera, -x)
   // and the floor (0.8 m below the target: z = -0.8, so d = 0.8 in a x + b y + c z + d = 0).
   bool wall = false, floor = false;
@@ -552,6 +558,8 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
       EXPECT_NE(diagnostics.message().find("odometry (odom_source) stopped"), std::string::npos)
           << diagnostics.message();
       EXPECT_EQ(diagnostics.value("metric source"), "odometry");
+      // The odometry's z is up and the camera upright: the map's up holds the planes.
+      EXPECT_EQ(diagnostics.value("map up (map/up_sigma_deg)"), "held to it (0.2 deg)");
     }
     // The first image after the pause goes without (nobody waits yet); then every one
     // has it, but for a wait a loaded machine (helgrind) may miss now and then.

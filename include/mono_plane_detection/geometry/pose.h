@@ -23,4 +23,13 @@ inline double rotationAngleDeg(const cv::Matx33d& R) {
   return std::acos(std::max(-1.0, std::min(1.0, (cv::trace(R) - 1) / 2))) * 180.0 / CV_PI;
 }
 
+// The angle (deg) between a camera's image up (its -y axis) and the direction `up`, both in
+// the frame map_from_camera maps into: 0 for an upright camera, 90 for one rolled on its
+// side or looking straight down.
+inline double cameraUpAngleDeg(const Pose& map_from_camera, const cv::Vec3d& up) {
+  const cv::Vec3d image_up = map_from_camera.R * cv::Vec3d(0, -1, 0);
+  const double c = image_up.dot(up) / cv::norm(up);
+  return std::acos(std::max(-1.0, std::min(1.0, c))) * 180.0 / CV_PI;
+}
+
 }  // namespace mono_plane_detection

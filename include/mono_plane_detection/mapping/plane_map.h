@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <map>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "mono_plane_detection/geometry/plane_fit.h"
@@ -42,12 +43,11 @@ struct MapParams {
   // to (or parallel to) better-known confirmed planes while its points do not reject that
   // at this many of their standard deviations (mapping/structure_fit.h); 0: off.
   double structure_sigmas = 3.0;
-  // How far the map's up (the core's +y: the start-up target's vertical edge, or the
-  // odometry frame's z) may be from the room's vertical, 1 sigma (deg). Floors, ceilings
-  // and walls are held level or upright by it as by a confirmed plane, while their points
-  // allow (structure_sigmas). 0.2: a target hung with a spirit level (1 mm over an A4
-  // sheet's long edge); hung by eye, 0.5-1; 0: off. Not with camera_height, whose up is its
-  // own floor's first fit (a map plane already).
+  // How far the map's up (PlaneMap::setVertical: the start-up target's y, hung upright on
+  // a wall, or the odometry frame's z) may be from the room's vertical, 1 sigma (deg).
+  // Floors, ceilings and walls are held level or upright by it as by a confirmed plane,
+  // while their points allow (structure_sigmas). 0.2: a target hung level with a spirit
+  // level (1 mm over an A4 sheet's long edge); hung by eye, 0.5-1; 0: off.
   double up_sigma_deg = 0.2;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
@@ -114,9 +114,11 @@ class PlaneMap {
 
   const std::vector<MapPlane>& planes() const { return planes_; }
   const MapParams& params() const { return params_; }
-  // Whether the map's +y is the room's vertical to within MapParams::up_sigma_deg (the
-  // target's or the odometry's up; not the floor fit of camera_height). Off until set.
-  void setUpIsVertical(bool vertical) { up_is_vertical_ = vertical; }
+  // The room's vertical in the map's frame, known to MapParams::up_sigma_deg (the target's
+  // or the odometry's up), or none (camera_height's own floor fit, a target on the floor):
+  // planes are held level or upright by it. None until set, and after reset().
+  void setVertical(const std::optional<cv::Vec3d>& up) { vertical_ = up; }
+  const std::optional<cv::Vec3d>& vertical() const { return vertical_; }
   void reset();
 
  private:
@@ -135,7 +137,7 @@ class PlaneMap {
   MapParams params_;
   std::vector<MapPlane> planes_;
   int next_id_ = 1;
-  bool up_is_vertical_ = false;
+  std::optional<cv::Vec3d> vertical_;
 };
 
 }  // namespace mono_plane_detection

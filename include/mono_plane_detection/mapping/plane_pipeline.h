@@ -128,6 +128,7 @@ class PlanePipeline {
   cv::Matx33d K_;
   cv::Mat distortion_;
   PlaneMap map_;
+  bool vertical_decided_ = false;  // the map's vertical set (PlaneMap::setVertical) for this map
   struct PastFrame {
     TrackFrame frame;
     std::optional<Pose> map_from_camera;
