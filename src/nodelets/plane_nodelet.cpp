@@ -885,7 +885,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     // rule 7): a user whose sheet lies on the floor sees why not.
     status.add("map up (map/up_sigma_deg)",
                params_.map.up_sigma_deg <= 0   ? std::string("off")
-               : metric_source_.empty()        ? std::string("no metric map yet")
+               : !pipeline_->verticalDecided() ? std::string("no metric map yet")
                : pipeline_->map().vertical()   ? "held to it (" + degreesText(params_.map.up_sigma_deg) + ")"
                : metric_source_ == "camera_height"
                    ? std::string("not used: the map's up is the floor's own fit")

@@ -32,8 +32,12 @@ TEST(PlanePipeline, MapsTheRoomsPlanesInMetres) {
   pipeline.setCamera(world.camera.K(), world.camera.distortion());
   const int frames = 240;
   int tracking = 0;
+  bool placed = false;
   for (int k = 0; k < frames; ++k) {
     const PipelineResult r = pipeline.process(world.frame(k / 30.0));
+    // The map's vertical is decided with the first image placed in metres, not before.
+    placed |= r.pose.has_value();
+    EXPECT_EQ(pipeline.verticalDecided(), placed) << "frame " << k;
     tracking += r.state == PipelineState::kTracking;
     if (k > 10) {
       EXPECT_FALSE(r.planes.empty()) << "frame " << k;
@@ -76,8 +80,10 @@ TEST(PlanePipeline, TheMapsVerticalIsTakenOnlyFromAnUprightCamera) {
       placed += pipeline.process(world.frame(k / 30.0), upright ? truth : turned * truth).pose.has_value();
     }
     ASSERT_GT(placed, 0) << upright;
+    EXPECT_TRUE(pipeline.verticalDecided());
     EXPECT_EQ(pipeline.map().vertical().has_value(), upright);
     pipeline.reset();
+    EXPECT_FALSE(pipeline.verticalDecided());
     EXPECT_FALSE(pipeline.map().vertical());
     pipeline.process(world.frame(1.0), upright ? world.truthMapFromCamera(1.0) : turned * world.truthMapFromCamera(1.0));
     EXPECT_EQ(pipeline.map().vertical().has_value(), upright) << "after a reset";

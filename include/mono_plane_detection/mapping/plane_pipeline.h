@@ -108,6 +108,9 @@ class PlanePipeline {
   PipelineResult process(const TrackFrame& frame, const std::optional<Pose>& odom_from_camera = {});
 
   const PlaneMap& map() const { return map_; }
+  // Whether the map's vertical (PlaneMap::vertical) has been decided for this map: at its
+  // first placed image with metres.
+  bool verticalDecided() const { return vertical_decided_; }
   const PoseEstimator* poseEstimator() const { return pose_ ? &*pose_ : nullptr; }
   const PipelineParams& params() const { return params_; }
   // The parameters read anew on every image (planes/..., frame_gap, max_gap_s): the next
