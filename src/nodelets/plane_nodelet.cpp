@@ -70,6 +70,23 @@ std::string degreesText(double deg) {
   return text.str();
 }
 
+// Whether loose floors and walls are held level / upright by the map's up (mapping.md,
+// rule 7), and if not why: a user whose sheet lies on the floor sees it.
+std::string mapUpText(const PlanePipeline& pipeline, const std::string& metric_source) {
+  const MapParams& map = pipeline.map().params();
+  if (map.up_sigma_deg <= 0) return "off";
+  if (map.structure_sigmas <= 0) return "off (map/structure_sigmas 0)";
+  if (map.up_sigma_deg >= map.max_normal_sigma_deg)
+    return "no effect: not below map/max_normal_sigma_deg";
+  if (!pipeline.verticalDecided()) return "not decided yet (at the first image placed in metres)";
+  if (pipeline.map().vertical()) return "held to it (" + degreesText(map.up_sigma_deg) + ")";
+  if (metric_source == "camera_height") return "not used: the map's up is the floor's own fit";
+  if (metric_source == "odometry")
+    return "not used: the camera at the map's start was not upright along the odometry's z";
+  return "not used: the camera at the map's start was not upright along the target's y (a "
+         "target on the floor or hung portrait?)";
+}
+
 }  // namespace
 
 class PlaneNodelet : public nodelet::Nodelet {
@@ -881,17 +898,7 @@ class PlaneNodelet : public nodelet::Nodelet {
                                            : tf_edge_);
     status.add("metric source", metric_source_.empty() ? "none yet (" + node_.pipeline.pose.metric_source + ")"
                                                        : metric_source_);
-    // Whether loose floors and walls are held level / upright by the map's up (mapping.md,
-    // rule 7): a user whose sheet lies on the floor sees why not.
-    status.add("map up (map/up_sigma_deg)",
-               params_.map.up_sigma_deg <= 0   ? std::string("off")
-               : !pipeline_->verticalDecided() ? std::string("no metric map yet")
-               : pipeline_->map().vertical()   ? "held to it (" + degreesText(params_.map.up_sigma_deg) + ")"
-               : metric_source_ == "camera_height"
-                   ? std::string("not used: the map's up is the floor's own fit")
-                   : std::string("not used: the camera at the map's start was not upright along "
-                                 "the target's y (a target on the floor or portrait?) or the "
-                                 "odometry's z"));
+    status.add("map up (map/up_sigma_deg)", mapUpText(*pipeline_, metric_source_));
     status.add("tracks with camera_info of another size (total)", info_size_mismatch_);
     status.add("tracks with camera_info of another frame_id (total)", info_frame_mismatch_);
     // Every start over of the map: ~reset calls and time going backwards (a bag loop).

@@ -362,7 +362,8 @@ const ParamTable<MapParams>& mapParamTable() {
        "how far the map's up (the target's y hung landscape on a wall, the odometry's z; "
        "taken when the map's first camera stands upright along it) may be from the room's "
        "vertical, 1 sigma: planes known worse are held level or upright by it while their "
-       "points allow (0.2: target hung with a spirit level; by eye 0.5-1; 0: off)"},
+       "points allow (0.2: target hung with a spirit level; by eye 0.5; 0 or from "
+       "map/max_normal_sigma_deg on: no effect)"},
       {"tentative_timeout_s", field(&P::tentative_timeout_s), 0, 1e6, "s",
        "unconfirmed planes unseen for this long are removed", "tentative_timeout_s"},
       {"fade_time_s", field(&P::fade_time_s), 1e-3, 1e6, "s",

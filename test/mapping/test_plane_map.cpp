@@ -483,7 +483,8 @@ TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
   map.reset();
   EXPECT_FALSE(map.vertical());
   std::mt19937 rng(3);
-  for (int k = 0; k < 8; ++k) map.update({floorStrip(rng, k, 20, -2.95, -2.65, 0.006)}, 1000 + 0.1 * k);
+  for (int k = 0; k < 8; ++k)
+    map.update({floorStrip(rng, k, 20, -2.95, -2.65, 0.006)}, 1000 + 0.1 * k);
   ASSERT_EQ(map.planes().size(), 1u);
   EXPECT_LT(normalAngleDeg(map.planes()[0].normal, map.planes()[0].own_normal), 1e-12);
 }
@@ -506,6 +507,9 @@ TEST(PlaneMap, ARampKeepsItsSlopeUnderTheMapsUp) {
     ASSERT_EQ(map.planes().size(), 1u) << up_sigma;
     const MapPlane& plane = map.planes()[0];
     ASSERT_TRUE(plane.confirmed(map.params())) << up_sigma;
+    // Known better than 0.2 deg (not offered) and worse than 0.01 (offered, refused).
+    ASSERT_LT(plane.normal_sigma_deg, 0.2);
+    ASSERT_GT(plane.normal_sigma_deg, 0.01);
     EXPECT_NEAR(normalAngleDeg(plane.normal, kFloor), 5.0, 0.3) << up_sigma;
     EXPECT_LT(normalAngleDeg(plane.normal, plane.own_normal), 1e-9) << up_sigma;
   }

@@ -74,19 +74,24 @@ TEST(PlanePipeline, TheMapsVerticalIsTakenOnlyFromAnUprightCamera) {
     params.pose.metric_source = "odometry";
     PlanePipeline pipeline(params);
     pipeline.setCamera(world.camera.K(), world.camera.distortion());
+    auto odometry = [&](double t) {
+      return upright ? world.truthMapFromCamera(t) : turned * world.truthMapFromCamera(t);
+    };
     int placed = 0;
-    for (int k = 0; k < 10; ++k) {
-      const Pose truth = world.truthMapFromCamera(k / 30.0);
-      placed += pipeline.process(world.frame(k / 30.0), upright ? truth : turned * truth).pose.has_value();
-    }
+    for (int k = 0; k < 10; ++k)
+      placed += pipeline.process(world.frame(k / 30.0), odometry(k / 30.0)).pose.has_value();
     ASSERT_GT(placed, 0) << upright;
     EXPECT_TRUE(pipeline.verticalDecided());
     EXPECT_EQ(pipeline.map().vertical().has_value(), upright);
     pipeline.reset();
     EXPECT_FALSE(pipeline.verticalDecided());
     EXPECT_FALSE(pipeline.map().vertical());
-    pipeline.process(world.frame(1.0), upright ? world.truthMapFromCamera(1.0) : turned * world.truthMapFromCamera(1.0));
+    pipeline.process(world.frame(1.0), odometry(1.0));
     EXPECT_EQ(pipeline.map().vertical().has_value(), upright) << "after a reset";
+    // Another camera starts another map, which decides again.
+    pipeline.setCamera(world.camera.K() * 1.01, world.camera.distortion());
+    EXPECT_FALSE(pipeline.verticalDecided());
+    EXPECT_FALSE(pipeline.map().vertical());
   }
 }
 

@@ -1018,6 +1018,9 @@ TEST_F(PlaneNodeletTest, P_TargetNotSeenIsAWarning) {
   EXPECT_NE(diagnostics.message().find("or start the metres without it (metric_source odometry"),
             std::string::npos)
       << diagnostics.message();
+  // No map yet: whether its up will hold the planes is decided at its first placed image.
+  EXPECT_EQ(diagnostics.value("map up (map/up_sigma_deg)"),
+            "not decided yet (at the first image placed in metres)");
   for (int k = 0; k < 3; ++k) ASSERT_TRUE(withoutTarget(1e8 + 5000 + k)) << k;  // a jump
   ASSERT_TRUE(diagnostics.waitFresh());
   ASSERT_TRUE(diagnostics.waitFresh());

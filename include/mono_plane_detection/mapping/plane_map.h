@@ -47,7 +47,8 @@ struct MapParams {
   // a wall, or the odometry frame's z) may be from the room's vertical, 1 sigma (deg).
   // Floors, ceilings and walls are held level or upright by it as by a confirmed plane,
   // while their points allow (structure_sigmas). 0.2: a target hung level with a spirit
-  // level (1 mm over an A4 sheet's long edge); hung by eye, 0.5-1; 0: off.
+  // level (1 mm over an A4 sheet's long edge); hung by eye, 0.5; 0: off. At or above
+  // max_normal_sigma_deg it does nothing (only planes fixed to that are held).
   double up_sigma_deg = 0.2;
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
