@@ -408,7 +408,7 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
         references.push_back({other.own_normal, other.normal_sigma_deg});
   // The room's vertical, as a horizontal plane known to up_sigma_deg, offered as the planes
   // are (to one known worse): a floor level, a wall upright.
-  if (holdable && vertical_ && params_.up_sigma_deg > 0 &&
+  if (holdable && vertical_ && params_.upCanHold() &&
       params_.up_sigma_deg < plane.normal_sigma_deg)
     references.push_back({*vertical_, params_.up_sigma_deg});
   if (!references.empty()) {

@@ -74,10 +74,10 @@ std::string degreesText(double deg) {
 // rule 7), and if not why: a user whose sheet lies on the floor sees it.
 std::string mapUpText(const PlanePipeline& pipeline, const std::string& metric_source) {
   const MapParams& map = pipeline.map().params();
-  if (map.up_sigma_deg <= 0) return "off";
-  if (map.structure_sigmas <= 0) return "off (map/structure_sigmas 0)";
-  if (map.up_sigma_deg >= map.max_normal_sigma_deg)
-    return "no effect: not below map/max_normal_sigma_deg";
+  if (!map.upCanHold())
+    return map.up_sigma_deg <= 0       ? "off"
+           : map.structure_sigmas <= 0 ? "off (map/structure_sigmas 0)"
+                                       : "no effect: not below map/max_normal_sigma_deg";
   if (!pipeline.verticalDecided()) return "not decided yet (at the first image placed in metres)";
   if (pipeline.map().vertical()) return "held to it (" + degreesText(map.up_sigma_deg) + ")";
   if (metric_source == "camera_height") return "not used: the map's up is the floor's own fit";

@@ -489,6 +489,24 @@ TEST(PlaneMap, AStripOfFloorIsHeldLevelByTheMapsUp) {
   EXPECT_LT(normalAngleDeg(map.planes()[0].normal, map.planes()[0].own_normal), 1e-12);
 }
 
+// The map's up holds a plane only where refit can use it: offered to planes known worse
+// than up_sigma_deg, held only if known to max_normal_sigma_deg, by structure_sigmas.
+TEST(PlaneMap, TheUpCanHoldOnlyBelowTheHoldingBound) {
+  MapParams p;
+  EXPECT_TRUE(p.upCanHold());  // 0.2 < 1 deg, structure on
+  MapParams off = p;
+  off.up_sigma_deg = 0;
+  EXPECT_FALSE(off.upCanHold());
+  MapParams no_structure = p;
+  no_structure.structure_sigmas = 0;
+  EXPECT_FALSE(no_structure.upCanHold());
+  MapParams by_eye = p;
+  by_eye.up_sigma_deg = by_eye.max_normal_sigma_deg;  // no plane both worse and held
+  EXPECT_FALSE(by_eye.upCanHold());
+  by_eye.up_sigma_deg = 0.5;
+  EXPECT_TRUE(by_eye.upCanHold());
+}
+
 // A ramp is not a floor: 2 m x 2 m of it, tilted 5 deg about x, points 1 cm off, fixes its
 // normal to about a tenth of a degree, and the map's up does not pull it level: at 0.2 deg
 // it is known worse than the ramp and not offered (as a plane is not); at 0.01 the points

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 
+#include "mono_plane_detection/geometry/plane_fit.h"
+
 namespace mono_plane_detection {
 
 // X_to = R * X_from + t.
@@ -27,9 +29,7 @@ inline double rotationAngleDeg(const cv::Matx33d& R) {
 // the frame map_from_camera maps into: 0 for an upright camera, 90 for one rolled on its
 // side or looking straight down.
 inline double cameraUpAngleDeg(const Pose& map_from_camera, const cv::Vec3d& up) {
-  const cv::Vec3d image_up = map_from_camera.R * cv::Vec3d(0, -1, 0);
-  const double c = image_up.dot(up) / cv::norm(up);
-  return std::acos(std::max(-1.0, std::min(1.0, c))) * 180.0 / CV_PI;
+  return normalAngleDeg(map_from_camera.R * cv::Vec3d(0, -1, 0), up);
 }
 
 }  // namespace mono_plane_detection

@@ -50,6 +50,11 @@ struct MapParams {
   // level (1 mm over an A4 sheet's long edge); hung by eye, 0.5; 0: off. At or above
   // max_normal_sigma_deg it does nothing (only planes fixed to that are held).
   double up_sigma_deg = 0.2;
+  // Whether the map's up can hold any plane: it is offered only to planes known worse than
+  // up_sigma_deg, and only planes known to max_normal_sigma_deg are held, by structure_sigmas.
+  bool upCanHold() const {
+    return up_sigma_deg > 0 && structure_sigmas > 0 && up_sigma_deg < max_normal_sigma_deg;
+  }
   double tentative_timeout_s = 2.0;   // unconfirmed planes not seen for this long are removed
   double fade_time_s = 20.0;          // confidence halves roughly every 0.7 x this unseen
   size_t max_planes = 32;             // lowest confidence removed beyond this
