@@ -41,6 +41,10 @@ echo "== the same with the allocator settings plane_detection.launch sets (what 
 env "${launch_malloc[@]}" rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" \
   --plot "$results/benchmark_tracker_floor_launch_malloc.png"
 echo
+echo "== the same with the search spread over 5 images (off by default: docs/benchmarks.md, tenth round)"
+rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" --spread 5 \
+  --plot "$results/benchmark_tracker_floor_spread.png"
+echo
 echo "== the same with predict_motion (off by default: docs/benchmarks.md, eighth round)"
 rosrun mono_plane_detection benchmark_tracker_floor "${real[@]}" --predict-motion 1 \
   --plot "$results/benchmark_tracker_floor_predict_motion.png"

@@ -110,7 +110,9 @@ const ParamTable<TrackerParams>& trackerParamTable() {
       {"redetect_every", field(&P::redetect_every), 1, 100000, "images",
        "search again at the latest after this many images (paper: 10)"},
       {"search_spread_images", field(&P::search_spread_images), 1, 10, "images",
-       "a search runs over this many images, a band of rows on each (1: the whole image)"},
+       "a search's work runs over this many images: the corner response in bands of rows, "
+       "the choice of corners as on the whole search image, their adoption (1: all on the "
+       "search image; 5: flat frame times, but the furnished room's maps were worse)"},
       {"match_radius_px", field(&P::match_radius_px), 0, 100, "px",
        "a new corner this close to a live point is that point (paper II-D)"},
       {"forward_backward_check", field(&P::forward_backward_check), 0, 1, "",

@@ -319,7 +319,8 @@ int main(int argc, char** argv) {
       .text("size", &only_size, "only the rows of this image size (profiling)", "WxH")
       .integer("features", &only_features, 0, 100000, "only the rows of this count (0: all)")
       .integer("spread", &spread, 0, 100,
-               "the tracker's search_spread_images (0: the tracker's default)")
+               "the tracker's search_spread_images, images a search's work runs over (0: the "
+               "tracker's default)")
       .integer("predict-motion", &predict, -1, 1,
                "the tracker's predict_motion, 0 or 1 (-1: the tracker's default)")
       .integer("noise-seed", &noise_seed, 0, 1000000,

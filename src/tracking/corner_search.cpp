@@ -156,7 +156,9 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
   relaxed_cells.clear();
   if (image.empty()) return;
   cv::Mat& eig = buffers.eig;
-  cv::cornerMinEigenVal(image, eig, block_size, 3);
+  if (!buffers.eig_ready || eig.size() != image.size() || eig.type() != CV_32FC1)
+    cv::cornerMinEigenVal(image, eig, block_size, 3);
+  buffers.eig_ready = false;
   double strongest = 0;
   cv::minMaxLoc(eig, nullptr, &strongest, nullptr, nullptr, mask);
   const float global_bar = static_cast<float>(quality_level * strongest);
@@ -444,40 +446,6 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
     buffers.from_full_resolution = static_cast<int>(corners.size() - coarse);
   }
   return corners;
-}
-
-void bandShares(const cv::Size& full, const cv::Mat& level_image, int level,
-                const std::vector<cv::Point2f>& live, int wanted, const TrackerParams& params,
-                CornerSearchBuffers& buffers, std::vector<int>& shares) {
-  std::fill(shares.begin(), shares.end(), 0);
-  if (shares.empty() || wanted <= 0 || level_image.empty() || full.empty()) return;
-  const float scale = static_cast<float>(1 << level);
-  const double min_distance = params.min_distance_px / scale;
-  const cv::Mat mask =
-      liveMask(level_image.size(), live, scale, min_distance, buffers.shares_mask);
-  const double cell_px = spreadCellPx(full, params.spread_grid_columns);
-  const double noise_floor =
-      cell_px > 0 && params.corner_noise_margin > 0
-          ? params.corner_noise_margin * noiseCornerFloor(level_image, level, params.block_size,
-                                                          cell_px / scale, &buffers.shares_noise)
-          : 0.0;
-  std::vector<cv::Point2f>& corners = buffers.shares_corners;
-  const size_t pool = static_cast<size_t>(cell_px > 0 ? std::max(wanted, 4 * params.max_features)
-                                                      : wanted);
-  shiTomasiCandidates(level_image, mask, params.quality_level, noise_floor, cell_px / scale,
-                      min_distance, params.block_size, noise_floor > 0 ? 0 : pool,
-                      buffers.shares_shi_tomasi, corners, buffers.shares_relaxed);
-  for (auto& c : corners) c *= scale;
-  if (cell_px > 0) spreadOverCells(corners, live, full, cell_px, static_cast<size_t>(wanted));
-  if (corners.size() > static_cast<size_t>(wanted)) corners.resize(wanted);
-  const int n = static_cast<int>(shares.size());
-  for (const auto& c : corners) {
-    // The band b with bandTop(b) <= y < bandTop(b + 1) (the tracker's bands).
-    int b = std::min(n - 1, static_cast<int>(c.y * n / full.height));
-    while (b > 0 && c.y < static_cast<float>(bandTop(b, full.height, n))) --b;
-    while (b < n - 1 && c.y >= static_cast<float>(bandTop(b + 1, full.height, n))) ++b;
-    ++shares[b];
-  }
 }
 
 double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int block_size) {

@@ -88,7 +88,9 @@ void FeatureTracker::reset() {
   frames_since_search_ = 0;
   coarse_came_short_ = false;
   searches_at_full_ = 0;
-  next_search_part_ = 0;
+  pyramid_previous_ = -1;
+  spread_image_ = -1;
+  spread_part_ = 0;
 }
 
 int minimumImageSide(const TrackerParams& params) {
@@ -115,33 +117,39 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   image_size_ = gray.size();
   stats_ = TrackerFrameStats();
 
-  // Built into the buffer of the image before last: same sizes, so no new memory.
+  // Built into a buffer that is neither the previous image's nor a spread search's:
+  // same sizes, so no new memory.
+  pyramid_now_ = 0;
+  while (pyramid_now_ == pyramid_previous_ || pyramid_now_ == spread_image_) ++pyramid_now_;
   std::vector<cv::Mat>& pyramid = pyramids_[pyramid_now_];
   levels_built_ = cv::buildOpticalFlowPyramid(gray, pyramid, lkWindow(params_),
                                               std::max(0, params_.pyramid_levels - 1));
 
   std::swap(previous_, current_);  // (swap, not move: both keep their capacity)
   current_.clear();
-  if (has_previous_pyramid_) trackFromPrevious(pyramids_[1 - pyramid_now_], pyramid, gray.size());
+  if (has_previous_pyramid_)
+    trackFromPrevious(pyramids_[pyramid_previous_], pyramid, gray.size());
   ++frames_since_search_;
 
   // Paper II-D: the search runs on this image, before the next one is loaded, so the
   // points still tracked here continue into the new set.
-  // A search costs a few images' tracking (at 320x240 a full-resolution corner search
-  // costs 2-3 images' Lucas-Kanade): it is spread over search_spread_images images, a
-  // band of rows on each from the top down, so that no image costs much more than the
-  // others. (Whole on the first image, when nothing is left, and in paper mode without
-  // the mask, where a search re-finds every live point's corner.)
-  if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()), frames_since_search_,
-                   params_)) {
-    const bool spread =
-        params_.mask_existing && !current_.empty() && params_.search_spread_images > 1;
-    search(gray, pyramid, spread ? 1 : 0);
-  } else if (next_search_part_ > 0) {
-    search(gray, pyramid, next_search_part_);
+  // A search costs a few images' tracking (at 640x480 a full-resolution corner search
+  // costs 3-4 images' Lucas-Kanade): with search_spread_images > 1 its work is spread over
+  // that many images, so that no image costs much more than the others. (Whole on the
+  // first image, when nothing is left, and in paper mode without the mask, where a search
+  // re-finds every live point's corner.)
+  if (spread_part_ > 0) {
+    continueSpreadSearch(gray, pyramid);
+  } else if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()),
+                          frames_since_search_, params_)) {
+    if (params_.mask_existing && !current_.empty() && params_.search_spread_images > 1) {
+      startSpreadSearch(gray);
+    } else {
+      search(gray, pyramid);
+    }
   }
   has_previous_pyramid_ = true;
-  pyramid_now_ = 1 - pyramid_now_;
+  pyramid_previous_ = pyramid_now_;
   ++frame_count_;
   return current_;
 }
@@ -395,61 +403,144 @@ void FeatureTracker::moveLostWithImage() {
   for (auto& l : lost_) l.uv += motion;
 }
 
-// part 0: the whole image; 1..search_spread_images: that band of rows, from the top.
-void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part) {
-  const int parts = std::max(1, params_.search_spread_images);
-  const int top = bandTop(part - 1, gray.rows, parts), bottom = bandTop(part, gray.rows, parts);
-  const cv::Rect band = part == 0 ? cv::Rect() : cv::Rect(0, top, gray.cols, bottom - top);
-  auto in_band = [&](const cv::Point2f& p) {
-    return band.empty() || (p.y >= band.y && p.y < band.y + band.height);
-  };
-  if (part > 1) {
-    stats_.search_rest = true;
-  } else {
-    stats_.searched = true;
-  }
-  next_search_part_ = part > 0 && part < parts ? part + 1 : 0;
-  if (params_.reanchor_on_search) reanchor(gray, in_band);
-  int wanted = params_.mask_existing ? params_.max_features - static_cast<int>(current_.size())
-                                     : params_.max_features;
-  // A coarse level that came up short (the image's corners are fine-grained, or more
-  // are wanted than it holds) costs a second search at full resolution: search there
-  // directly, and try the coarse level again every fourth search (band).
-  const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
-  const int level = try_coarse ? cornerSearchLevel(gray.size(), levels_built_, params_) : 0;
+// Paper II-B on the whole image at once.
+void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid) {
+  stats_.searched = true;
+  if (params_.reanchor_on_search) reanchor(gray);
+  const int wanted = params_.mask_existing
+                         ? params_.max_features - static_cast<int>(current_.size())
+                         : params_.max_features;
+  const int level = searchLevel(gray.size());
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
   static const std::vector<cv::Point2f> kNone;
   // The pyramid holds each level's image and derivatives in turn (2 entries per level).
   const size_t per_level = pyramid.size() / (levels_built_ + 1);
-  // Each band takes, of what is still missing, the part that a search of the whole image
-  // would put in its rows and the bands after it (bandShares on the first band's image,
-  // one level coarser than the search); the last band, all of it. Equal shares made the
-  // bands of dark rows take weak corners (docs/benchmarks.md, fifth and sixth rounds).
-  if (part == 1) {
-    band_shares_.assign(static_cast<size_t>(parts), 0);
-    const int shares_level = std::min(levels_built_, level + 1);
-    bandShares(gray.size(), pyramid[shares_level * per_level], shares_level,
-               params_.mask_existing ? live : kNone, wanted, params_, search_buffers_,
-               band_shares_);
-  }
-  if (part > 0 && part < parts) {
-    int rest = 0;
-    for (int b = part - 1; b < static_cast<int>(band_shares_.size()); ++b) rest += band_shares_[b];
-    wanted = rest > 0 ? (wanted * band_shares_[part - 1] + rest / 2) / rest
-                      : (wanted + parts - part) / (parts - part + 1);
-  }
   const std::vector<cv::Point2f>& corners =
       findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
-                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr, band);
+                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr);
+  noteSearchLevel(level);
+  adoptCorners(gray, corners);
+  found_at_last_search_ = static_cast<int>(current_.size());
+  frames_since_search_ = 0;
+}
 
-  // Matched corners are the same physical point as a live one: the live point keeps
-  // its id and its sub-pixel tracked position.
+// A coarse level that came up short (the image's corners are fine-grained, or more are
+// wanted than it holds) costs a second search at full resolution: search there directly,
+// and try the coarse level again every fourth search.
+int FeatureTracker::searchLevel(const cv::Size& size) const {
+  const bool try_coarse = !coarse_came_short_ || searches_at_full_ >= 3;
+  return try_coarse ? cornerSearchLevel(size, levels_built_, params_) : 0;
+}
+
+void FeatureTracker::noteSearchLevel(int level) {
   if (level > 0) {
     coarse_came_short_ = search_buffers_.from_full_resolution > 0;
     searches_at_full_ = 0;
   } else if (coarse_came_short_) {
     ++searches_at_full_;
   }
+}
+
+// A search spread over search_spread_images images (docs/tracking.md): the search image
+// is kept, its corner response computed in bands of rows, one per image (responseBands),
+// the corners chosen from it on the next image exactly as a search of the whole image
+// would choose them there, and adopted on the last: followed from the search image to
+// that one by Lucas-Kanade, then matched, re-identified and added as any search's.
+void FeatureTracker::startSpreadSearch(const cv::Mat& gray) {
+  stats_.searched = true;
+  if (params_.reanchor_on_search) reanchor(gray);
+  spread_level_ = searchLevel(gray.size());
+  spread_wanted_ = params_.max_features - static_cast<int>(current_.size());
+  spread_live_.clear();
+  for (const auto& p : current_) spread_live_.push_back(p.uv);
+  spread_image_ = pyramid_now_;
+  spread_part_ = 0;
+  responseBand(spread_part_++);
+  frames_since_search_ = 0;  // (the paper's count runs from the search image)
+}
+
+// Band b of responseBands() of the kept search image's response, into the search's buffer;
+// rows beyond the band are computed with it so that its edge rows are the whole image's.
+void FeatureTracker::responseBand(int b) {
+  const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
+  const size_t per_level = kept.size() / (levels_built_ + 1);
+  const cv::Mat& level_image = kept[spread_level_ * per_level];
+  const int bands = responseBands();
+  const int r0 = bandTop(b, level_image.rows, bands), r1 = bandTop(b + 1, level_image.rows, bands);
+  const int margin = params_.block_size / 2 + 2;
+  const int a = std::max(0, r0 - margin), z = std::min(level_image.rows, r1 + margin);
+  cv::Mat& response = search_buffers_.shi_tomasi.eig;
+  response.create(level_image.size(), CV_32FC1);
+  if (r1 <= r0) return;
+  // (Into a kept buffer of the largest band's size: the bands differ by a row or two.)
+  const int most = bandTop(1, level_image.rows, bands) + 2 * margin + 1;
+  if (response_band_.rows < most || response_band_.cols != level_image.cols)
+    response_band_.create(most, level_image.cols, CV_32FC1);
+  cv::Mat band = response_band_.rowRange(0, z - a);
+  cv::cornerMinEigenVal(level_image.rowRange(a, z), band, params_.block_size, 3);
+  band.rowRange(r0 - a, r1 - a).copyTo(response.rowRange(r0, r1));
+}
+
+void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
+                                          const std::vector<cv::Mat>& pyramid) {
+  stats_.search_rest = true;
+  const int bands = responseBands();
+  const int part = spread_part_++;
+  if (part < bands) {
+    responseBand(part);
+    return;
+  }
+  const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
+  if (part == bands) {
+    const size_t per_level = kept.size() / (levels_built_ + 1);
+    search_buffers_.shi_tomasi.eig_ready = true;
+    spread_corners_ = findCorners(kept[0], kept[spread_level_ * per_level], spread_level_,
+                                  spread_live_, spread_wanted_, params_, search_buffers_,
+                                  per_level == 2 ? &kept[1] : nullptr);
+    search_buffers_.shi_tomasi.eig_ready = false;
+    noteSearchLevel(spread_level_);
+    // With three images or more, the corners are adopted on the next one.
+    if (params_.search_spread_images >= 3) return;
+  }
+  // The corners followed from the search image to this one: the full pyramid and the
+  // forward-backward check, as any point.
+  const std::vector<cv::Point2f>& corners = spread_corners_;
+  std::vector<cv::Point2f>& followed = fresh_uv_;
+  followed.clear();
+  if (!corners.empty()) {
+    const cv::Size window = lkWindow(params_);
+    const cv::TermCriteria criteria = lkCriteria(params_);
+    cv::calcOpticalFlowPyrLK(kept, pyramid, corners, spread_to_, spread_status_, error_, window,
+                             fullLevel(), criteria, 0, params_.min_eigen_threshold);
+    if (params_.forward_backward_check)
+      cv::calcOpticalFlowPyrLK(pyramid, kept, spread_to_, spread_back_, spread_back_status_,
+                               error_, window, fullLevel(), criteria, 0,
+                               params_.min_eigen_threshold);
+    const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
+    for (size_t c = 0; c < corners.size(); ++c) {
+      if (!spread_status_[c] || !inside(spread_to_[c], gray.size())) continue;
+      if (params_.forward_backward_check) {
+        const cv::Point2f d = spread_back_[c] - corners[c];
+        if (!spread_back_status_[c] || d.dot(d) > fb_max2) continue;
+      }
+      followed.push_back(spread_to_[c]);
+    }
+  }
+  spread_image_ = -1;
+  spread_part_ = 0;
+  // Two points may have come closer since the search image: the spacing rule again.
+  const int wanted = params_.max_features - static_cast<int>(current_.size());
+  keepApart(followed, positionsOf(current_, live_uv_), params_.min_distance_px,
+            std::max(0, wanted));
+  adoptCorners(gray, followed);
+  found_at_last_search_ = static_cast<int>(current_.size());
+}
+
+// Paper II-D: corners that match a live point are that point (it keeps its id and its
+// sub-pixel tracked position); the others are new points, or lost points come back (by
+// their ORB descriptors).
+void FeatureTracker::adoptCorners(const cv::Mat& gray, const std::vector<cv::Point2f>& corners) {
+  const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
   const std::vector<int> match = matchCornersToPoints(corners, live, params_.match_radius_px);
   std::vector<TrackedPoint>& fresh = fresh_;
   fresh.clear();
@@ -468,12 +559,10 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 
   // One ORB call for the live points and the new corners: the new corners' part is
   // compared with the lost points, and all are remembered for when they get lost.
-  // (Of the live points, those in the band: the others are described on the other
-  // images of the search.)
   std::vector<cv::Mat> descriptors;
   described_.clear();
   if (params_.reidentify) {
-    selectInBand(in_band);
+    selectLive();
     for (const auto& p : fresh) live_uv_.push_back(p.uv);
     descriptors = orbDescriptors(gray, live_uv_);
     const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + described_.size(),
@@ -493,8 +582,15 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
       described_.push_back(static_cast<int>(k));
     refreshDescriptors(descriptors);
   }
-  found_at_last_search_ = static_cast<int>(current_.size());
-  if (part <= 1) frames_since_search_ = 0;
+}
+
+void FeatureTracker::selectLive() {
+  described_.clear();
+  live_uv_.clear();
+  for (size_t i = 0; i < current_.size(); ++i) {
+    described_.push_back(static_cast<int>(i));
+    live_uv_.push_back(current_[i].uv);
+  }
 }
 
 // Lucas-Kanade with a translation-only window follows the centroid of the window's
@@ -503,20 +599,8 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
 // corner at each search bounds the drift to the images between searches. (Spreading it
 // over the images, a share of the points on each, was measured: errors grew by up to
 // half on real textures and the search image's time hardly changed.)
-template <class InBand>
-void FeatureTracker::selectInBand(const InBand& in_band) {
-  described_.clear();
-  live_uv_.clear();
-  for (size_t i = 0; i < current_.size(); ++i) {
-    if (!in_band(current_[i].uv)) continue;
-    described_.push_back(static_cast<int>(i));
-    live_uv_.push_back(current_[i].uv);
-  }
-}
-
-template <class InBand>
-void FeatureTracker::reanchor(const cv::Mat& gray, const InBand& in_band) {
-  selectInBand(in_band);
+void FeatureTracker::reanchor(const cv::Mat& gray) {
+  selectLive();
   if (live_uv_.empty()) return;
   std::vector<cv::Point2f>& refined = live_uv_;
   const int half = params_.reanchor_window_px;

@@ -434,25 +434,44 @@ TEST(CornerSearch, AWeakPatchGetsCornersAndAFlatNoisyPatchNone) {
   }
 }
 
-// bandShares gives each band of rows what a search of the whole image would put there:
-// strong squares in the lower third and faint ones in the upper third, the cells of the
-// lower rows as empty as those of the upper: the strong corners come first.
-TEST(CornerSearch, BandSharesFollowTheWholeImagesStrongestCorners) {
+// A response computed beforehand (a spread search computes it in bands of rows, each with
+// a few rows beyond it, on successive images) is used instead of computing it: the same
+// corners as computed in one go, used once, and a wrong-sized one is not used at all.
+TEST(CornerSearch, AResponseComputedInBandsGivesTheSameCorners) {
   const cv::Size size(640, 480);
-  Squares s = squares(size);
-  // The upper third's squares faint (200 -> 46 over a background of 40).
-  cv::Mat upper = s.image(cv::Rect(0, 0, size.width, size.height / 3));
-  upper = (upper - 40) / 26 + 40;
-  std::vector<cv::Mat> pyramid;
-  cv::buildPyramid(s.image, pyramid, 2);
-  TrackerParams params;
-  params.max_features = 400;
-  std::vector<int> shares(3, 0);
-  CornerSearchBuffers buffers;
-  bandShares(size, pyramid[2], 2, {}, 30, params, buffers, shares);
-  EXPECT_EQ(shares[0] + shares[1] + shares[2], 30);
-  EXPECT_LT(shares[0], shares[2]);
-  // Nothing wanted: nothing shared.
-  bandShares(size, pyramid[2], 2, {}, 0, params, buffers, shares);
-  EXPECT_EQ(shares[0] + shares[1] + shares[2], 0);
+  const cv::Mat image = squares(size).image;
+  ShiTomasiBuffers once, banded;
+  std::vector<cv::Point2f> expected, corners;
+  std::vector<uchar> relaxed;
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, once, expected, relaxed);
+  ASSERT_GT(expected.size(), 50u);
+  banded.eig.create(size, CV_32FC1);
+  cv::Mat band;
+  for (int b = 0; b < 3; ++b) {
+    const int r0 = bandTop(b, size.height, 3), r1 = bandTop(b + 1, size.height, 3);
+    const int a = std::max(0, r0 - 3), z = std::min(size.height, r1 + 3);
+    cv::cornerMinEigenVal(image.rowRange(a, z), band, 3, 3);
+    band.rowRange(r0 - a, r1 - a).copyTo(banded.eig.rowRange(r0, r1));
+  }
+  cv::Mat whole;
+  cv::cornerMinEigenVal(image, whole, 3, 3);
+  EXPECT_EQ(cv::norm(whole, banded.eig, cv::NORM_INF), 0.0);  // bit for bit
+  banded.eig_ready = true;
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  EXPECT_FALSE(banded.eig_ready);
+  EXPECT_EQ(corners, expected);
+  // Used once: a response left in the buffer (here zeros) is not taken again.
+  banded.eig.setTo(0);
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  EXPECT_EQ(corners, expected);
+  // Zeros marked ready give nothing: the flag is what decides (the test can fail).
+  banded.eig.setTo(0);
+  banded.eig_ready = true;
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  EXPECT_TRUE(corners.empty());
+  // Of another size: computed.
+  banded.eig = cv::Mat::zeros(10, 10, CV_32FC1);
+  banded.eig_ready = true;
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  EXPECT_EQ(corners, expected);
 }

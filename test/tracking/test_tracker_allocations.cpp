@@ -3,7 +3,9 @@
 // program (glibc lets a program do that); what remains is OpenCV's own small buffers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdio>
 #include <cstddef>
 
 #include "support/tracker_ground_truth.h"
@@ -41,5 +43,47 @@ TEST(TrackerAllocations, ImagesWithoutSearchAllocateNoImageMemory) {
   // issue 17) would show here. OpenCV's filters and LK keep ~14 small blocks (~21 kB).
   EXPECT_LT(bytes / images_counted, 64 * 1024) << allocations / images_counted << " allocations";
   EXPECT_LE(allocations / images_counted, 24);
+#endif
+}
+
+// A spread search (search_spread_images 5) spreads the memory a search takes as it
+// spreads its time: no image of it allocates as much as the whole-image search's image
+// (OpenCV's work images of the corner response are a band's, not the image's).
+TEST(TrackerAllocations, ASpreadSearchAllocatesLessPerImageThanAWholeSearch) {
+#if !MPD_OWN_MALLOC
+  GTEST_SKIP() << "AddressSanitizer replaces malloc itself";
+#else
+  const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
+  const cv::Size view(640, 480);
+  const auto hs = translations(80, {-180, -160}, {3.0, 0.5}, 0.001);
+  std::vector<cv::Mat> images;
+  for (const auto& H : hs) images.push_back(warpView(texture, H, view));
+  // The most bytes any search image after the start-up allocates.
+  auto largest = [&](int spread, int* search_images) {
+    TrackerParams params;
+    params.max_features = 150;
+    params.search_spread_images = spread;
+    FeatureTracker tracker(params);
+    long most = 0;
+    *search_images = 0;
+    for (size_t k = 0; k < images.size(); ++k) {
+      g_bytes = 0;
+      g_counting = true;
+      tracker.process(images[k]);
+      g_counting = false;
+      const auto& stats = tracker.lastStats();
+      if (k < 25 || !(stats.searched || stats.search_rest)) continue;
+      ++*search_images;
+      most = std::max(most, static_cast<long>(g_bytes));
+    }
+    return most;
+  };
+  int whole_images = 0, spread_images = 0;
+  const long whole = largest(1, &whole_images), spread = largest(5, &spread_images);
+  ASSERT_GE(whole_images, 4);
+  ASSERT_GE(spread_images, 4 * 5);
+  std::printf("most allocated by a search image: whole %ld kB, spread %ld kB\n",
+              whole / 1024, spread / 1024);
+  EXPECT_LT(spread, whole / 2);
 #endif
 }

@@ -71,6 +71,9 @@ struct RelaxedCells {
 // Work buffers of shiTomasiCandidates.
 struct ShiTomasiBuffers {
   cv::Mat eig, dilated;
+  // eig already holds the image's response (computed in bands by a spread search): the
+  // next shiTomasiCandidates uses it instead of computing it, once.
+  bool eig_ready = false;
   std::vector<float> bar;
   std::vector<int> column_cell;
   std::vector<std::pair<float, int>> candidates;
@@ -99,27 +102,11 @@ struct CornerSearchBuffers {
   std::vector<std::pair<double, cv::Point2f>> scored;
   std::vector<cv::Point2f> taken;
   int from_full_resolution = 0;  // of the last search's corners, found by the fill
-  // bandShares' own (another pyramid level: kept apart so that neither reallocates).
-  ShiTomasiBuffers shares_shi_tomasi;
-  NoiseLevelBuffers shares_noise;
-  cv::Mat shares_mask;
-  std::vector<cv::Point2f> shares_corners;
-  std::vector<uchar> shares_relaxed;
 };
 
 // The first row of band b of a spread search over n bands of `rows` rows (band b holds
-// the rows bandTop(b) <= y < bandTop(b + 1)): the tracker's and bandShares' cut.
+// the rows bandTop(b) <= y < bandTop(b + 1)): the tracker's cut.
 inline int bandTop(int b, int rows, int n) { return b * rows / n; }
-
-// How many of `wanted` new corners a search of the whole image would put in each of
-// `shares.size()` bands of rows of `full` (bandTop), estimated on `level_image`, level `level` of full's pyramid (one coarser than the
-// search's, so that it costs little): the candidates above the quality bar under the live
-// points' mask, spread over the cells as the search spreads them (spreadOverCells: the
-// emptiest cells first, the image's strongest corner first among equals). Sums to at most
-// `wanted`.
-void bandShares(const cv::Size& full, const cv::Mat& level_image, int level,
-                const std::vector<cv::Point2f>& live, int wanted, const TrackerParams& params,
-                CornerSearchBuffers& buffers, std::vector<int>& shares);
 
 // Shi-Tomasi's corner score (the smaller eigenvalue of the gradient matrix summed over a
 // block_size square) at the pixel nearest p, from x and y derivatives (CV_16SC2, as

@@ -54,10 +54,12 @@ struct TrackerParams {
   // When to search again (paper II-C).
   double redetect_lost_fraction = 2.0 / 3.0;  // of the points found at the last search
   int redetect_every = 10;                    // frames between searches at the latest
-  // Beyond the paper: a search runs over this many images, a band of rows on each, so
-  // that the search image does not cost several images' tracking (1: all at once, the
-  // default: 3 flattens frame times, but its mean error is higher on a few rows,
-  // docs/benchmarks.md, sixth round).
+  // Beyond the paper: a search's work runs over this many images so that the search
+  // image does not cost several images' tracking: the search image's corner response in
+  // bands of rows on the first ones, the choice of corners (as on the whole search image)
+  // on the next, their adoption on the last (followed there by Lucas-Kanade). 1: all on
+  // the search image, the default: 5 flattens frame times at the tracking quality of 1
+  // (docs/benchmarks.md, tenth round), but the furnished room's maps were worse with it.
   int search_spread_images = 1;
 
   // Matching new corners to existing points (paper II-D).
@@ -178,12 +180,20 @@ class FeatureTracker {
   int fullLevel() const {
     return std::min(std::max(0, params_.pyramid_levels - 1), levels_built_);
   }
-  void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid, int part);
-  template <class InBand>
-  void reanchor(const cv::Mat& gray, const InBand& in_band);
-  // described_ and live_uv_: the live points in the band (indices into current_, positions).
-  template <class InBand>
-  void selectInBand(const InBand& in_band);
+  void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
+  int searchLevel(const cv::Size& size) const;
+  void noteSearchLevel(int level);
+  void startSpreadSearch(const cv::Mat& gray);
+  void continueSpreadSearch(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
+  // The bands of rows a spread search computes its response in, one per image; the
+  // corners are chosen on the image after the last band and (from 3 images on) adopted
+  // on the one after that.
+  int responseBands() const { return std::max(1, params_.search_spread_images - 2); }
+  void responseBand(int band);
+  void adoptCorners(const cv::Mat& gray, const std::vector<cv::Point2f>& corners);
+  void reanchor(const cv::Mat& gray);
+  // described_ and live_uv_: every live point (indices into current_, positions).
+  void selectLive();
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
@@ -198,10 +208,22 @@ class FeatureTracker {
   // One pyramid per image (with its derivatives), shared by Lucas-Kanade forward and
   // backward and the corner search; two kept buffers take turns so that the steady
   // state allocates no image memory.
-  std::vector<cv::Mat> pyramids_[2];
+  // Three: the image's, the previous image's, and a spread search's image kept for it.
+  std::vector<cv::Mat> pyramids_[3];
   int pyramid_now_ = 0;
+  int pyramid_previous_ = -1;
   bool has_previous_pyramid_ = false;
   int levels_built_ = 0;
+  // A spread search in progress (spread_part_ > 0: images of it done so far).
+  int spread_image_ = -1;  // its search image's pyramid, -1: none
+  int spread_part_ = 0;
+  int spread_level_ = 0;   // the pyramid level it searches
+  int spread_wanted_ = 0;  // corners it may add
+  std::vector<cv::Point2f> spread_live_;     // the live points on its search image (the mask)
+  std::vector<cv::Point2f> spread_corners_;  // the corners chosen, on its search image
+  std::vector<cv::Point2f> spread_to_, spread_back_;
+  std::vector<uchar> spread_status_, spread_back_status_;
+  cv::Mat response_band_;
   // Per-image work buffers, kept for their capacity.
   std::vector<cv::Point2f> before_, after_, back_, live_uv_, fresh_uv_;
   std::vector<uchar> status_, back_status_;
@@ -221,8 +243,6 @@ class FeatureTracker {
   int frames_since_search_ = 0;
   bool coarse_came_short_ = false;  // the last coarse search needed full resolution too
   int searches_at_full_ = 0;        // searches since, at full resolution
-  int next_search_part_ = 0;  // the band of a spread search the next image runs, 0: none
-  std::vector<int> band_shares_;  // of a spread search, per band (bandShares on its first image)
   std::unordered_map<std::uint64_t, cv::Mat> descriptors_;  // live points, by id
   std::vector<LostPoint> lost_;                             // re-identification pool
 };
