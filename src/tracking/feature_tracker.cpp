@@ -138,8 +138,13 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   // that many images, so that no image costs much more than the others. (Whole on the
   // first image, when nothing is left, and in paper mode without the mask, where a search
   // re-finds every live point's corner.)
-  if (spread_part_ > 0) {
-    continueSpreadSearch(gray, pyramid);
+  if (spread_part_ > 0 && current_.empty()) {
+    // Nothing left before a spread search ends: the whole image now, as on the first.
+    spread_image_ = -1;
+    spread_part_ = 0;
+    search(gray, pyramid);
+  } else if (spread_part_ > 0) {
+    continueSpreadSearch(gray, pyramid);  // (the paper's triggers wait for it to end)
   } else if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()),
                           frames_since_search_, params_)) {
     if (params_.mask_existing && !current_.empty() && params_.search_spread_images > 1) {

@@ -460,6 +460,49 @@ TEST(FeatureTracker, SearchSpreadsOverSuccessiveImages) {
   EXPECT_GE(parts_seen[5], 3);
 }
 
+// A spread search in progress gives way: when every point is lost (a black image) the
+// next textured image is searched whole at once, and a new image size starts over (no
+// kept image of the old size is used).
+TEST(FeatureTracker, ASpreadSearchInProgressGivesWayToAWholeSearchWhenNeeded) {
+  TrackerParams params;
+  params.max_features = 150;
+  params.search_spread_images = 5;
+  const auto hs = translations(30, kCentred, {4.0, 0.0});
+  for (const bool black : {true, false}) {
+    FeatureTracker tracker(params);
+    size_t k = 0;
+    for (; k < hs.size(); ++k) {
+      tracker.process(warpView(texture(), hs[k], kView));
+      if (k > 0 && tracker.lastStats().searched) break;  // a spread search starts here
+    }
+    ASSERT_LT(k, hs.size());
+    ASSERT_EQ(tracker.lastStats().added, 0);  // (spread: nothing added on its first image)
+    if (black) {
+      EXPECT_TRUE(tracker.process(cv::Mat::zeros(kView, CV_8UC1)).empty());
+    } else {
+      const cv::Mat half = warpView(texture(), hs[k], kView);
+      cv::Mat smaller;
+      cv::resize(half, smaller, cv::Size(kView.width / 2, kView.height / 2));
+      EXPECT_GE(tracker.process(smaller).size(), 60u);  // started over, searched whole
+    }
+    const cv::Size size = black ? kView : cv::Size(kView.width / 2, kView.height / 2);
+    cv::Mat next = warpView(texture(), hs[k + 1], kView);
+    if (!black) cv::resize(next, next, size);
+    const auto& points = tracker.process(next);
+    if (black) {
+      EXPECT_TRUE(tracker.lastStats().searched);
+      EXPECT_GE(points.size(), 140u) << "refilled at once, not at the spread's end";
+    } else {
+      EXPECT_GE(points.size(), 50u);  // followed on the new size
+    }
+    for (int more = 2; more < 8; ++more) {
+      cv::Mat image = warpView(texture(), hs[k + more], kView);
+      if (!black) cv::resize(image, image, size);
+      EXPECT_GE(tracker.process(image).size(), 40u) << "image " << k + more;
+    }
+  }
+}
+
 // The spread search takes the corners a search of the whole image would take on its
 // first image: with the camera still from there on, the corners it adds on its last image
 // are those search_spread_images 1 adds on the search image (the live points masked, the
