@@ -14,15 +14,24 @@
 
 using namespace mono_plane_detection;
 
+namespace {
+
+// 640x480 views of a generated texture moving by `step` px per image.
+std::vector<cv::Mat> moving640x480(int frames, const cv::Point2d& step) {
+  const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
+  std::vector<cv::Mat> images;
+  for (const auto& H : translations(frames, {-180, -160}, step, 0.001))
+    images.push_back(warpView(texture, H, {640, 480}));
+  return images;
+}
+
+}  // namespace
+
 TEST(TrackerAllocations, ImagesWithoutSearchAllocateNoImageMemory) {
 #if !MPD_OWN_MALLOC
   GTEST_SKIP() << "AddressSanitizer replaces malloc itself";
 #else
-  const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
-  const cv::Size view(640, 480);
-  const auto hs = translations(60, {-180, -160}, {1.0, 0.5}, 0.001);
-  std::vector<cv::Mat> images;
-  for (const auto& H : hs) images.push_back(warpView(texture, H, view));
+  const std::vector<cv::Mat> images = moving640x480(60, {1.0, 0.5});
   FeatureTracker tracker;
   long images_counted = 0, allocations = 0, bytes = 0;
   for (size_t k = 0; k < images.size(); ++k) {
@@ -53,11 +62,7 @@ TEST(TrackerAllocations, ASpreadSearchAllocatesLessPerImageThanAWholeSearch) {
 #if !MPD_OWN_MALLOC
   GTEST_SKIP() << "AddressSanitizer replaces malloc itself";
 #else
-  const cv::Mat texture = makeCornerTexture({1000, 800}, 42);
-  const cv::Size view(640, 480);
-  const auto hs = translations(80, {-180, -160}, {3.0, 0.5}, 0.001);
-  std::vector<cv::Mat> images;
-  for (const auto& H : hs) images.push_back(warpView(texture, H, view));
+  const std::vector<cv::Mat> images = moving640x480(80, {3.0, 0.5});
   // The most bytes any search image after the start-up allocates.
   auto largest = [&](int spread, int* search_images) {
     TrackerParams params;
