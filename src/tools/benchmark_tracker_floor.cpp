@@ -352,7 +352,7 @@ int main(int argc, char** argv) {
       "run on each image right after ours. ms = CPU ms of the thread per image (mean / p95 /\n"
       "max; wall = wall-clock mean, the machine is shared); alloc = heap allocations per\n"
       "image from image %d on (whole process, OpenCV included), images without / with\n"
-      "(a band of) a corner search, and kB; err = px from the truth; kept = share followed\n"
+      "(an image of) a corner search, and kB; err = px from the truth; kept = share followed\n"
       "image to image;\n"
       "ids100 = ids of image 0 still there at image 99; reid = share of new corners that\n"
       "got a lost id back; srch = images with a search; pts = points followed per image,\n"

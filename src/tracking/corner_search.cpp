@@ -148,17 +148,36 @@ double noiseCornerFloor(const cv::Mat& image, int level, int block_size, double 
   return noiseResponsePerLevel2(level, block_size) * noise * noise;
 }
 
+void cornerResponseRows(const cv::Mat& image, int block_size, int first_row, int end_row,
+                        cv::Mat& response, cv::Mat& work) {
+  response.create(image.size(), CV_32FC1);
+  first_row = std::max(0, first_row);
+  end_row = std::min(image.rows, end_row);
+  if (end_row <= first_row) return;
+  // Sobel 3 reads a row each way, the block sum block_size / 2 more: with the rows
+  // beyond them the band's edge rows are those of the whole image, bit for bit.
+  const int margin = block_size / 2 + 2;
+  const int a = std::max(0, first_row - margin), z = std::min(image.rows, end_row + margin);
+  // (A kept buffer of the largest band's size so far: bands differ by a row or two.)
+  if (work.rows < z - a || work.cols != image.cols || work.type() != CV_32FC1)
+    work.create(z - a, image.cols, CV_32FC1);
+  cv::Mat rows = work.rowRange(0, z - a);
+  cv::cornerMinEigenVal(image.rowRange(a, z), rows, block_size, 3);
+  rows.rowRange(first_row - a, end_row - a).copyTo(response.rowRange(first_row, end_row));
+}
+
 void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
                          double noise_floor, double cell_px, double min_distance, int block_size,
                          size_t max_corners, ShiTomasiBuffers& buffers,
-                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed_cells) {
+                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed_cells,
+                         cv::Mat* response) {
   corners.clear();
   relaxed_cells.clear();
   if (image.empty()) return;
-  cv::Mat& eig = buffers.eig;
-  if (!buffers.eig_ready || eig.size() != image.size() || eig.type() != CV_32FC1)
-    cv::cornerMinEigenVal(image, eig, block_size, 3);
-  buffers.eig_ready = false;
+  const bool given = response != nullptr && response->size() == image.size() &&
+                     response->type() == CV_32FC1;
+  cv::Mat& eig = given ? *response : buffers.eig;
+  if (!given) cv::cornerMinEigenVal(image, eig, block_size, 3);
   double strongest = 0;
   cv::minMaxLoc(eig, nullptr, &strongest, nullptr, nullptr, mask);
   const float global_bar = static_cast<float>(quality_level * strongest);
@@ -252,7 +271,7 @@ bool RelaxedCells::contains(const cv::Point2f& p) const {
   if (relaxed.empty() || cols <= 0 || cell_px <= 0) return false;
   const float scale = static_cast<float>(1 << level);
   const int cx = static_cast<int>(p.x / scale / cell_px);
-  const int cy = static_cast<int>((p.y / scale - top) / cell_px);
+  const int cy = static_cast<int>(p.y / scale / cell_px);
   const int rows = static_cast<int>(relaxed.size()) / cols;
   if (cx < 0 || cy < 0) return false;
   return relaxed[std::min(rows - 1, cy) * cols + std::min(cols - 1, cx)] != 0;
@@ -312,21 +331,13 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                                             int level, const std::vector<cv::Point2f>& live,
                                             int wanted, const TrackerParams& params,
                                             CornerSearchBuffers& buffers,
-                                            const cv::Mat* derivatives, const cv::Rect& band) {
+                                            const cv::Mat* derivatives, cv::Mat* response) {
   std::vector<cv::Point2f>& corners = buffers.corners;
   corners.clear();
   buffers.from_full_resolution = 0;
   buffers.relaxed.relaxed.clear();
   if (wanted <= 0) return corners;
   const float scale = static_cast<float>(1 << level);
-  // The band on this level (whole rows of it: the band's edges are rows).
-  const cv::Rect whole(0, 0, level_image.cols, level_image.rows);
-  const cv::Rect on_level =
-      band.empty() ? whole
-                   : cv::Rect(0, band.y >> level, level_image.cols,
-                              ((band.y + band.height + (1 << level) - 1) >> level) - (band.y >> level)) &
-                         whole;
-  if (on_level.empty()) return corners;
   const double min_distance = params.min_distance_px / scale;
   const cv::Mat mask = liveMask(level_image.size(), live, scale, min_distance, buffers.mask);
   // On a coarse level, three times as many as wanted: they are ranked again at full
@@ -342,27 +353,23 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   const int pool = spread ? std::max(ask, 4 * params.max_features) : ask;
   // Per-cell bars (the grid's cells on this level) above the noise floor: then every
   // candidate goes to the spread, or the strong cells' corners would fill the pool.
-  const cv::Mat searched = level_image(on_level);
+  const cv::Mat& searched = level_image;
   RelaxedCells& relaxed = buffers.relaxed;
   relaxed.cell_px = cell_px / scale;
   relaxed.level = level;
-  relaxed.top = on_level.y;
   const double noise_floor =
       spread && params.corner_noise_margin > 0
           ? params.corner_noise_margin * noiseCornerFloor(searched, level, params.block_size,
                                                           relaxed.cell_px, &buffers.noise)
           : 0.0;
-  // (An image region of a larger Mat: OpenCV's filters read the pixels around it, so
-  // the scores at the band's edge are those of the whole image.)
-  shiTomasiCandidates(searched, mask.empty() ? mask : mask(on_level), params.quality_level,
-                      noise_floor, relaxed.cell_px, min_distance, params.block_size,
+  shiTomasiCandidates(searched, mask, params.quality_level, noise_floor, relaxed.cell_px,
+                      min_distance, params.block_size,
                       noise_floor > 0 ? 0 : static_cast<size_t>(pool), buffers.shi_tomasi, corners,
-                      relaxed.relaxed);
+                      relaxed.relaxed, response);
   relaxed.cols =
       relaxed.relaxed.empty() ? 0 : static_cast<int>(std::ceil(searched.cols / relaxed.cell_px));
   if (corners.empty()) return corners;
-  const cv::Point2f offset(0.f, static_cast<float>(on_level.y));
-  for (auto& c : corners) c = (c + offset) * scale;  // pyrDown keeps pixel 2i of level i-1 at i
+  for (auto& c : corners) c *= scale;  // pyrDown keeps pixel 2i of level i-1 at i
   if (spread) spreadOverCells(corners, live, full.size(), cell_px, ask);
   // Score: the best of the pixel nearest the corner and its 8 neighbours (a corner found
   // by goodFeaturesToTrack is its neighbourhood's maximum).
@@ -402,14 +409,13 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                 corners.end());
   // Then by the score where the corner really is, as a full-resolution search would.
   if (rank) rankBy(params.block_size, corners.size());
-  // goodFeaturesToTrack's quality_level is relative to the best corner it sees: in a band,
-  // the band's best; at full resolution under the mask of the live points, the best
-  // unmasked one (their corners, the strongest, hidden: each search lowered the bar). The
-  // bar of a search of the whole image is set by the best corner found or live instead
-  // (a cell's own bar does not depend on the band). (Coarse searches keep their level's
-  // bar: with the full-resolution one the furnished room's humanoid floor moved
-  // 0.019 -> 0.037 m, docs/benchmarks.md.)
-  if (derivatives != nullptr && (level == 0 || !band.empty())) {
+  // goodFeaturesToTrack's quality_level is relative to the best corner it sees: at full
+  // resolution under the mask of the live points, the best unmasked one (their corners,
+  // the strongest, hidden: each search lowered the bar). The bar of a search is set by
+  // the best corner found or live instead (a cell's own bar does not depend on it).
+  // (Coarse searches keep their level's bar: with the full-resolution one the furnished
+  // room's humanoid floor moved 0.019 -> 0.037 m, docs/benchmarks.md.)
+  if (derivatives != nullptr && level == 0) {
     double best = 0;
     for (const auto& c : corners) best = std::max(best, score(c, params.block_size));
     for (const auto& c : live) best = std::max(best, score(c, params.block_size));
@@ -436,8 +442,7 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
     taken = live;
     taken.insert(taken.end(), corners.begin(), corners.end());
     std::vector<cv::Point2f> found = std::move(corners);
-    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers,
-                nullptr, band);
+    findCorners(full, full, 0, taken, wanted - static_cast<int>(found.size()), params, buffers);
     const size_t coarse = found.size();
     for (const auto& c : buffers.corners)
       if (buffers.relaxed.contains(c) || score(c, params.block_size) >= params.quality_level * best)

@@ -122,8 +122,10 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   pyramid_now_ = 0;
   while (pyramid_now_ == pyramid_previous_ || pyramid_now_ == spread_image_) ++pyramid_now_;
   std::vector<cv::Mat>& pyramid = pyramids_[pyramid_now_];
-  levels_built_ = cv::buildOpticalFlowPyramid(gray, pyramid, lkWindow(params_),
-                                              std::max(0, params_.pyramid_levels - 1));
+  // (Never a view into `gray`: a spread search keeps the pyramid for several images.)
+  levels_built_ = cv::buildOpticalFlowPyramid(
+      gray, pyramid, lkWindow(params_), std::max(0, params_.pyramid_levels - 1), true,
+      cv::BORDER_REFLECT_101, cv::BORDER_CONSTANT, /*tryReuseInputImage=*/false);
 
   std::swap(previous_, current_);  // (swap, not move: both keep their capacity)
   current_.clear();
@@ -144,10 +146,15 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
     spread_part_ = 0;
     search(gray, pyramid);
   } else if (spread_part_ > 0) {
-    continueSpreadSearch(gray, pyramid);  // (the paper's triggers wait for it to end)
+    // (The paper's triggers wait for it to end; the points lost meanwhile are not
+    // counted towards the next 2/3, which counts from the corners it adds.)
+    continueSpreadSearch(gray, pyramid);
   } else if (shouldSearch(found_at_last_search_, static_cast<int>(current_.size()),
                           frames_since_search_, params_)) {
-    if (params_.mask_existing && !current_.empty() && params_.search_spread_images > 1) {
+    // (Spread only when corners are wanted: a full tracker's search re-anchors and
+    // describes its points, which the whole-image search does at once.)
+    if (params_.mask_existing && !current_.empty() && params_.search_spread_images > 1 &&
+        static_cast<int>(current_.size()) < params_.max_features) {
       startSpreadSearch(gray);
     } else {
       search(gray, pyramid);
@@ -464,26 +471,14 @@ void FeatureTracker::startSpreadSearch(const cv::Mat& gray) {
   frames_since_search_ = 0;  // (the paper's count runs from the search image)
 }
 
-// Band b of responseBands() of the kept search image's response, into the search's buffer;
-// rows beyond the band are computed with it so that its edge rows are the whole image's.
+// Band b of responseBands() of the kept search image's response.
 void FeatureTracker::responseBand(int b) {
   const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
   const size_t per_level = kept.size() / (levels_built_ + 1);
   const cv::Mat& level_image = kept[spread_level_ * per_level];
   const int bands = responseBands();
-  const int r0 = bandTop(b, level_image.rows, bands), r1 = bandTop(b + 1, level_image.rows, bands);
-  const int margin = params_.block_size / 2 + 2;
-  const int a = std::max(0, r0 - margin), z = std::min(level_image.rows, r1 + margin);
-  cv::Mat& response = search_buffers_.shi_tomasi.eig;
-  response.create(level_image.size(), CV_32FC1);
-  if (r1 <= r0) return;
-  // (Into a kept buffer of the largest band's size: the bands differ by a row or two.)
-  const int most = bandTop(1, level_image.rows, bands) + 2 * margin + 1;
-  if (response_band_.rows < most || response_band_.cols != level_image.cols)
-    response_band_.create(most, level_image.cols, CV_32FC1);
-  cv::Mat band = response_band_.rowRange(0, z - a);
-  cv::cornerMinEigenVal(level_image.rowRange(a, z), band, params_.block_size, 3);
-  band.rowRange(r0 - a, r1 - a).copyTo(response.rowRange(r0, r1));
+  cornerResponseRows(level_image, params_.block_size, bandTop(b, level_image.rows, bands),
+                     bandTop(b + 1, level_image.rows, bands), spread_response_, response_rows_);
 }
 
 void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
@@ -498,11 +493,9 @@ void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
   const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
   if (part == bands) {
     const size_t per_level = kept.size() / (levels_built_ + 1);
-    search_buffers_.shi_tomasi.eig_ready = true;
     spread_corners_ = findCorners(kept[0], kept[spread_level_ * per_level], spread_level_,
                                   spread_live_, spread_wanted_, params_, search_buffers_,
-                                  per_level == 2 ? &kept[1] : nullptr);
-    search_buffers_.shi_tomasi.eig_ready = false;
+                                  per_level == 2 ? &kept[1] : nullptr, &spread_response_);
     noteSearchLevel(spread_level_);
     // With three images or more, the corners are adopted on the next one.
     if (params_.search_spread_images >= 3) return;

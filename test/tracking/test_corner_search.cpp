@@ -236,37 +236,6 @@ TEST(CornerSearch, MaskedSearchKeepsTheQualityBarOfTheLivePoints) {
   EXPECT_GE(search(0.25), 20);
 }
 
-// A band of rows searches those rows only; the two halves of an image together find
-// what one search of the whole image finds (the quality bar is the best corner found or
-// live, not the band's own best).
-TEST(CornerSearch, BandsOfRowsTogetherFindWhatTheWholeImageHolds) {
-  const Squares truth = squares({640, 480});
-  int levels = 0;
-  const auto pyramid = pyramidOf(truth.image, &levels);
-  TrackerParams params;
-  CornerSearchBuffers buffers;
-  const size_t whole =
-      findCorners(truth.image, pyramid[2], 1, {}, 1000, params, buffers, &pyramid[1]).size();
-  ASSERT_GT(whole, 100u);
-  std::vector<cv::Point2f> found;
-  for (const cv::Rect band : {cv::Rect(0, 0, 640, 240), cv::Rect(0, 240, 640, 240)}) {
-    const auto& corners = findCorners(truth.image, pyramid[2], 1, found, 1000, params, buffers,
-                                      &pyramid[1], band);
-    ASSERT_FALSE(corners.empty());
-    for (const auto& c : corners) {
-      EXPECT_GE(c.y, band.y - 1.0f);  // (refinement moves a corner by less than a pixel)
-      EXPECT_LT(c.y, band.y + band.height + 1.0f);
-      EXPECT_LT(nearest(c, truth.corners), 0.5);
-    }
-    found.insert(found.end(), corners.begin(), corners.end());
-  }
-  EXPECT_EQ(found.size(), whole);
-  // A band off the image finds nothing.
-  EXPECT_TRUE(findCorners(truth.image, pyramid[2], 1, {}, 50, params, buffers, &pyramid[1],
-                          cv::Rect(0, 600, 640, 100))
-                  .empty());
-}
-
 TEST(CornerSearch, SpreadOverCellsServesTheCellWithFewestPointsFirst) {
   // Strongest first: three corners in the cell at the origin, then two in the next one.
   const std::vector<cv::Point2f> input{{10, 10}, {30, 10}, {50, 10}, {110, 10}, {130, 10}};
@@ -434,44 +403,56 @@ TEST(CornerSearch, AWeakPatchGetsCornersAndAFlatNoisyPatchNone) {
   }
 }
 
-// A response computed beforehand (a spread search computes it in bands of rows, each with
-// a few rows beyond it, on successive images) is used instead of computing it: the same
-// corners as computed in one go, used once, and a wrong-sized one is not used at all.
-TEST(CornerSearch, AResponseComputedInBandsGivesTheSameCorners) {
+// cornerResponseRows: bands of rows of the response, on the images a spread search keeps
+// (pyramid levels, whose rows beyond the image are its border), are bit for bit the whole
+// response, for any block size and number of bands; rows outside the band are untouched.
+TEST(CornerSearch, ResponseRowsInBandsAreTheWholeImagesResponse) {
+  const cv::Mat image = squares({640, 480}).image;
+  std::vector<cv::Mat> pyramid;
+  cv::buildOpticalFlowPyramid(image, pyramid, cv::Size(7, 7), 2);
+  cv::Mat whole, banded, work;
+  for (int level = 0; level <= 2; ++level) {
+    const cv::Mat& level_image = pyramid[2 * level];
+    for (const int block : {1, 2, 3, 4, 7, 31}) {
+      cv::cornerMinEigenVal(level_image, whole, block, 3);
+      for (const int bands : {1, 3, 8}) {
+        banded = cv::Mat(level_image.size(), CV_32FC1, cv::Scalar(-1));
+        for (int b = 0; b < bands; ++b)
+          cornerResponseRows(level_image, block, bandTop(b, level_image.rows, bands),
+                             bandTop(b + 1, level_image.rows, bands), banded, work);
+        EXPECT_EQ(cv::norm(whole, banded, cv::NORM_INF), 0.0)
+            << "level " << level << ", block " << block << ", " << bands << " bands";
+      }
+    }
+  }
+  // One band: only its rows are written.
+  banded = cv::Mat(image.size(), CV_32FC1, cv::Scalar(-1));
+  cornerResponseRows(image, 3, 100, 200, banded, work);
+  EXPECT_EQ(banded.at<float>(99, 320), -1.f);
+  EXPECT_EQ(banded.at<float>(200, 320), -1.f);
+  EXPECT_NE(banded.at<float>(150, 320), -1.f);
+}
+
+// A response given to shiTomasiCandidates is used instead of computing one: the same
+// corners as computing it; zeros given give none (the test can fail); one of another size
+// is not used.
+TEST(CornerSearch, AGivenResponseIsUsedInsteadOfComputingIt) {
   const cv::Size size(640, 480);
   const cv::Mat image = squares(size).image;
-  ShiTomasiBuffers once, banded;
+  ShiTomasiBuffers buffers;
   std::vector<cv::Point2f> expected, corners;
   std::vector<uchar> relaxed;
-  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, once, expected, relaxed);
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, buffers, expected, relaxed);
   ASSERT_GT(expected.size(), 50u);
-  banded.eig.create(size, CV_32FC1);
-  cv::Mat band;
-  for (int b = 0; b < 3; ++b) {
-    const int r0 = bandTop(b, size.height, 3), r1 = bandTop(b + 1, size.height, 3);
-    const int a = std::max(0, r0 - 3), z = std::min(size.height, r1 + 3);
-    cv::cornerMinEigenVal(image.rowRange(a, z), band, 3, 3);
-    band.rowRange(r0 - a, r1 - a).copyTo(banded.eig.rowRange(r0, r1));
-  }
-  cv::Mat whole;
-  cv::cornerMinEigenVal(image, whole, 3, 3);
-  EXPECT_EQ(cv::norm(whole, banded.eig, cv::NORM_INF), 0.0);  // bit for bit
-  banded.eig_ready = true;
-  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
-  EXPECT_FALSE(banded.eig_ready);
+  cv::Mat response, work;
+  cornerResponseRows(image, 3, 0, size.height, response, work);
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, buffers, corners, relaxed,
+                      &response);
   EXPECT_EQ(corners, expected);
-  // Used once: a response left in the buffer (here zeros) is not taken again.
-  banded.eig.setTo(0);
-  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
-  EXPECT_EQ(corners, expected);
-  // Zeros marked ready give nothing: the flag is what decides (the test can fail).
-  banded.eig.setTo(0);
-  banded.eig_ready = true;
-  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  cv::Mat zeros = cv::Mat::zeros(size, CV_32FC1);
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, buffers, corners, relaxed, &zeros);
   EXPECT_TRUE(corners.empty());
-  // Of another size: computed.
-  banded.eig = cv::Mat::zeros(10, 10, CV_32FC1);
-  banded.eig_ready = true;
-  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, banded, corners, relaxed);
+  cv::Mat small = cv::Mat::zeros(10, 10, CV_32FC1);
+  shiTomasiCandidates(image, cv::Mat(), 0.01, 0, 0, 15, 3, 0, buffers, corners, relaxed, &small);
   EXPECT_EQ(corners, expected);
 }

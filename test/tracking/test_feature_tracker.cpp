@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
@@ -458,6 +459,64 @@ TEST(FeatureTracker, SearchSpreadsOverSuccessiveImages) {
     }
   }
   EXPECT_GE(parts_seen[5], 3);
+}
+
+// With the camera moving, the corners a spread search adds on its last image are those a
+// whole-image search adds on the search image, followed there: each at its whole-image
+// position plus the image's motion since (the response of the kept image, the choice on
+// it, the corners followed from it).
+TEST(FeatureTracker, ASpreadSearchAddsTheWholeImageSearchsCornersFollowedToItsLastImage) {
+  const auto hs = translations(30, kCentred, {4.0, 1.0});
+  for (const int spread : {2, 5}) {
+    auto run = [&](int images_spread, std::vector<cv::Point2f>* added,
+                   std::map<std::uint64_t, cv::Point2f>* at_search,
+                   std::map<std::uint64_t, cv::Point2f>* at_added) {
+      TrackerParams params;
+      params.max_features = 150;
+      params.search_spread_images = images_spread;
+      FeatureTracker tracker(params);
+      for (size_t k = 0; k < hs.size(); ++k) {
+        const auto& points = tracker.process(warpView(texture(), hs[k], kView));
+        if (k == 0) continue;
+        if (tracker.lastStats().searched && at_search->empty())
+          for (const auto& p : points) (*at_search)[p.id] = p.uv;
+        for (const auto& p : points)
+          if (p.is_new) added->push_back(p.uv);
+        if (!added->empty()) {
+          for (const auto& p : points) (*at_added)[p.id] = p.uv;
+          return static_cast<int>(k);
+        }
+      }
+      return -1;
+    };
+    std::vector<cv::Point2f> whole, spread_added;
+    std::map<std::uint64_t, cv::Point2f> whole_search, whole_added, at_search, at_added;
+    const int whole_image = run(1, &whole, &whole_search, &whole_added);
+    const int spread_image = run(spread, &spread_added, &at_search, &at_added);
+    ASSERT_GT(whole_image, 0);
+    EXPECT_EQ(spread_image, whole_image + spread - 1);
+    // The image's motion from the search image to the last: the live points' median.
+    std::vector<float> dx, dy;
+    for (const auto& [id, uv] : at_search)
+      if (at_added.count(id)) {
+        dx.push_back(at_added[id].x - uv.x);
+        dy.push_back(at_added[id].y - uv.y);
+      }
+    ASSERT_GT(dx.size(), 50u);
+    std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+    std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
+    const cv::Point2f motion(dx[dx.size() / 2], dy[dy.size() / 2]);
+    EXPECT_GT(cv::norm(motion), 3.0 * (spread - 1)) << "the camera moved";
+    ASSERT_GE(whole.size(), 10u);
+    EXPECT_EQ(spread_added.size(), whole.size()) << "spread " << spread;
+    int matched = 0;
+    for (const auto& w : whole) {
+      double best = 1e9;
+      for (const auto& p : spread_added) best = std::min(best, cv::norm(p - (w + motion)));
+      matched += best < 0.05;
+    }
+    EXPECT_EQ(matched, static_cast<int>(whole.size())) << "spread " << spread;
+  }
 }
 
 // A spread search in progress gives way: when every point is lost (a black image) the

@@ -63,7 +63,6 @@ struct RelaxedCells {
   int cols = 0;
   double cell_px = 0;  // on the searched image
   int level = 0;       // the searched image is this pyramid level
-  int top = 0;         // its first row on that level (a band)
   // True when p (full-resolution pixels) lies in a relaxed cell.
   bool contains(const cv::Point2f& p) const;
 };
@@ -71,9 +70,6 @@ struct RelaxedCells {
 // Work buffers of shiTomasiCandidates.
 struct ShiTomasiBuffers {
   cv::Mat eig, dilated;
-  // eig already holds the image's response (computed in bands by a spread search): the
-  // next shiTomasiCandidates uses it instead of computing it, once.
-  bool eig_ready = false;
   std::vector<float> bar;
   std::vector<int> column_cell;
   std::vector<std::pair<float, int>> candidates;
@@ -87,10 +83,13 @@ struct ShiTomasiBuffers {
 // strongest, but at least noise_floor). noise_floor <= 0 or cell_px <= 0: the image's bar
 // alone, as goodFeaturesToTrack. Strongest first, each at least min_distance from those
 // before, at most max_corners (0: all). `relaxed` gets the cells whose bar was lowered.
+// `response`, when given and of the image's size (CV_32FC1), is the image's response
+// computed beforehand: used (and thresholded in place) instead of computing it.
 void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quality_level,
                          double noise_floor, double cell_px, double min_distance, int block_size,
                          size_t max_corners, ShiTomasiBuffers& buffers,
-                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed);
+                         std::vector<cv::Point2f>& corners, std::vector<uchar>& relaxed,
+                         cv::Mat* response = nullptr);
 
 // Buffers kept across searches so that a search allocates nothing they can hold.
 struct CornerSearchBuffers {
@@ -108,6 +107,13 @@ struct CornerSearchBuffers {
 // the rows bandTop(b) <= y < bandTop(b + 1)): the tracker's cut.
 inline int bandTop(int b, int rows, int n) { return b * rows / n; }
 
+// Rows first_row <= y < end_row of `image`'s Shi-Tomasi response (cornerMinEigenVal,
+// block_size, Sobel 3) into `response` (made the image's size, CV_32FC1; its other rows
+// are left as they are), bit for bit those of the whole image's response: a spread search
+// computes its search image's response a band of rows per image. `work`: a kept buffer.
+void cornerResponseRows(const cv::Mat& image, int block_size, int first_row, int end_row,
+                        cv::Mat& response, cv::Mat& work);
+
 // Shi-Tomasi's corner score (the smaller eigenvalue of the gradient matrix summed over a
 // block_size square) at the pixel nearest p, from x and y derivatives (CV_16SC2, as
 // cv::buildOpticalFlowPyramid stores them next to each level); pixels outside are left out.
@@ -119,10 +125,10 @@ double shiTomasiScore(const cv::Mat& derivatives, const cv::Point2f& p, int bloc
 // from the live points, which also mask the search. At most `wanted`. On a coarse level,
 // three times as many candidates are ranked again by shiTomasiScore on `derivatives`
 // (full resolution's, CV_16SC2) when given, and the best refined. When the coarse level
-// holds fewer than `wanted`, full resolution gives the rest. A non-empty `band` (rows of
-// `full`; its x and width are ignored) limits the search to those rows (the tracker
-// spreads a search over two images, a half on each); the quality bar is then set by the
-// best corner found or live (needs `derivatives`), not the band's best. With
+// holds fewer than `wanted`, full resolution gives the rest. `response`, when given, is
+// level_image's Shi-Tomasi response computed beforehand (cornerResponseRows; it is
+// thresholded in place), used instead of computing it (not by the full-resolution rest
+// of a coarse search, which computes its own). With
 // params.corner_noise_margin > 0 and a spread grid, each cell of the grid also has its own
 // bar (shiTomasiCandidates), above the noise floor times that margin.
 const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& level_image,
@@ -130,6 +136,6 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
                                             int wanted, const TrackerParams& params,
                                             CornerSearchBuffers& buffers,
                                             const cv::Mat* derivatives = nullptr,
-                                            const cv::Rect& band = cv::Rect());
+                                            cv::Mat* response = nullptr);
 
 }  // namespace mono_plane_detection

@@ -84,7 +84,7 @@ struct TrackedPoint {
   std::uint64_t id = 0;  // unique, increasing, never reused
   cv::Point2f uv;        // pixel position in the current image
   // (The paper's 3D position lives with the landmarks: mapping/pose_estimator.h.)
-  bool is_new = false;            // found by the search on this image
+  bool is_new = false;            // new on this image (found by a search)
   bool is_tracked = false;        // followed by Lucas-Kanade from the previous image
   bool is_reidentified = false;   // new corner that got back the id of a lost point
   bool is_target_corner = false;  // a corner of the start-up target (paper II-A)
@@ -100,7 +100,7 @@ struct TrackerFrameStats {
   int matched = 0;       // new corners that matched a live point (kept its id)
   int reidentified = 0;  // new corners that got back a lost id
   bool searched = false;     // a search started on this image (the paper's search image)
-  bool search_rest = false;  // a later band of a search started on an earlier image
+  bool search_rest = false;  // a later image of a spread search started on an earlier one
   int lk_levels = 0;   // pyramid levels of most points' forward pass (fewer when predicted)
   int lk_retried = 0;  // points the full pyramid was run again for (predict_motion)
 };
@@ -206,9 +206,9 @@ class FeatureTracker {
   std::vector<TrackedPoint> current_;
   TrackerFrameStats stats_;
   // One pyramid per image (with its derivatives), shared by Lucas-Kanade forward and
-  // backward and the corner search; two kept buffers take turns so that the steady
-  // state allocates no image memory.
-  // Three: the image's, the previous image's, and a spread search's image kept for it.
+  // backward and the corner search; kept buffers take turns (the image's, the previous
+  // image's, and a spread search's image kept for it) so that the steady state allocates
+  // no image memory.
   std::vector<cv::Mat> pyramids_[3];
   int pyramid_now_ = 0;
   int pyramid_previous_ = -1;
@@ -223,7 +223,8 @@ class FeatureTracker {
   std::vector<cv::Point2f> spread_corners_;  // the corners chosen, on its search image
   std::vector<cv::Point2f> spread_to_, spread_back_;
   std::vector<uchar> spread_status_, spread_back_status_;
-  cv::Mat response_band_;
+  cv::Mat spread_response_;  // its search image's response, computed a band per image
+  cv::Mat response_rows_;    // cornerResponseRows' work buffer
   // Per-image work buffers, kept for their capacity.
   std::vector<cv::Point2f> before_, after_, back_, live_uv_, fresh_uv_;
   std::vector<uchar> status_, back_status_;
