@@ -353,21 +353,20 @@ const std::vector<cv::Point2f>& findCorners(const cv::Mat& full, const cv::Mat& 
   const int pool = spread ? std::max(ask, 4 * params.max_features) : ask;
   // Per-cell bars (the grid's cells on this level) above the noise floor: then every
   // candidate goes to the spread, or the strong cells' corners would fill the pool.
-  const cv::Mat& searched = level_image;
   RelaxedCells& relaxed = buffers.relaxed;
   relaxed.cell_px = cell_px / scale;
   relaxed.level = level;
   const double noise_floor =
       spread && params.corner_noise_margin > 0
-          ? params.corner_noise_margin * noiseCornerFloor(searched, level, params.block_size,
+          ? params.corner_noise_margin * noiseCornerFloor(level_image, level, params.block_size,
                                                           relaxed.cell_px, &buffers.noise)
           : 0.0;
-  shiTomasiCandidates(searched, mask, params.quality_level, noise_floor, relaxed.cell_px,
+  shiTomasiCandidates(level_image, mask, params.quality_level, noise_floor, relaxed.cell_px,
                       min_distance, params.block_size,
                       noise_floor > 0 ? 0 : static_cast<size_t>(pool), buffers.shi_tomasi, corners,
                       relaxed.relaxed, response);
   relaxed.cols =
-      relaxed.relaxed.empty() ? 0 : static_cast<int>(std::ceil(searched.cols / relaxed.cell_px));
+      relaxed.relaxed.empty() ? 0 : static_cast<int>(std::ceil(level_image.cols / relaxed.cell_px));
   if (corners.empty()) return corners;
   for (auto& c : corners) c *= scale;  // pyrDown keeps pixel 2i of level i-1 at i
   if (spread) spreadOverCells(corners, live, full.size(), cell_px, ask);

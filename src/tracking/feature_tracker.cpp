@@ -79,7 +79,6 @@ FeatureTracker::FeatureTracker(const TrackerParams& params) : params_(params) {}
 void FeatureTracker::reset() {
   previous_.clear();
   current_.clear();
-  has_previous_pyramid_ = false;  // (the buffers stay for their memory)
   descriptors_.clear();
   lost_.clear();
   stats_ = TrackerFrameStats();
@@ -129,7 +128,7 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
 
   std::swap(previous_, current_);  // (swap, not move: both keep their capacity)
   current_.clear();
-  if (has_previous_pyramid_)
+  if (pyramid_previous_ >= 0)
     trackFromPrevious(pyramids_[pyramid_previous_], pyramid, gray.size());
   ++frames_since_search_;
 
@@ -160,7 +159,6 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
       search(gray, pyramid);
     }
   }
-  has_previous_pyramid_ = true;
   pyramid_previous_ = pyramid_now_;
   ++frame_count_;
   return current_;
@@ -313,6 +311,25 @@ int FeatureTracker::measureImageMotion(const std::vector<cv::Mat>& previous_pyra
   return max_level;
 }
 
+// The paper's full pyramidal pass from `from` to `to` and, with the forward-backward check,
+// the full pass back from where they went (back_status empty without the check).
+void FeatureTracker::fullPass(const std::vector<cv::Mat>& from_pyramid,
+                              const std::vector<cv::Mat>& to_pyramid,
+                              const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>& to,
+                              std::vector<uchar>& status, std::vector<cv::Point2f>& back,
+                              std::vector<uchar>& back_status) {
+  const cv::Size window = lkWindow(params_);
+  const cv::TermCriteria criteria = lkCriteria(params_);
+  cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, from, to, status, error_, window,
+                           fullLevel(), criteria, 0, params_.min_eigen_threshold);
+  back_status.clear();
+  if (!params_.forward_backward_check) return;
+  back = to;
+  cv::calcOpticalFlowPyrLK(to_pyramid, from_pyramid, to, back, back_status, error_, window,
+                           fullLevel(), criteria, cv::OPTFLOW_USE_INITIAL_FLOW,
+                           params_.min_eigen_threshold);
+}
+
 // The paper's full pyramidal pass, from the old position, for the points the short pass
 // from the prediction did not keep, with the full backward pass as their check.
 void FeatureTracker::retryOnFullPyramid(const std::vector<cv::Mat>& previous_pyramid,
@@ -326,17 +343,8 @@ void FeatureTracker::retryOnFullPyramid(const std::vector<cv::Mat>& previous_pyr
   }
   stats_.lk_retried = static_cast<int>(recheck_index_.size());
   if (recheck_index_.empty()) return;
-  const cv::Size window = lkWindow(params_);
-  const int max_level = fullLevel();
-  const cv::TermCriteria criteria = lkCriteria(params_);
-  cv::calcOpticalFlowPyrLK(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_,
-                           error_, window, max_level, criteria, 0, params_.min_eigen_threshold);
-  if (params_.forward_backward_check) {
-    recheck_back_ = recheck_to_;
-    cv::calcOpticalFlowPyrLK(pyramid, previous_pyramid, recheck_to_, recheck_back_,
-                             recheck_back_status_, error_, window, max_level, criteria,
-                             cv::OPTFLOW_USE_INITIAL_FLOW, params_.min_eigen_threshold);
-  }
+  fullPass(previous_pyramid, pyramid, recheck_from_, recheck_to_, recheck_status_, recheck_back_,
+           recheck_back_status_);
   for (size_t k = 0; k < recheck_index_.size(); ++k) {
     const int i = recheck_index_[k];
     after_[i] = recheck_to_[k];
@@ -425,11 +433,9 @@ void FeatureTracker::search(const cv::Mat& gray, const std::vector<cv::Mat>& pyr
   const int level = searchLevel(gray.size());
   const std::vector<cv::Point2f>& live = positionsOf(current_, live_uv_);
   static const std::vector<cv::Point2f> kNone;
-  // The pyramid holds each level's image and derivatives in turn (2 entries per level).
-  const size_t per_level = pyramid.size() / (levels_built_ + 1);
   const std::vector<cv::Point2f>& corners =
-      findCorners(gray, pyramid[level * per_level], level, params_.mask_existing ? live : kNone,
-                  wanted, params_, search_buffers_, per_level == 2 ? &pyramid[1] : nullptr);
+      findCorners(gray, levelImage(pyramid, level), level, params_.mask_existing ? live : kNone,
+                  wanted, params_, search_buffers_, fullDerivatives(pyramid));
   noteSearchLevel(level);
   adoptCorners(gray, corners);
   found_at_last_search_ = static_cast<int>(current_.size());
@@ -463,8 +469,7 @@ void FeatureTracker::startSpreadSearch(const cv::Mat& gray) {
   if (params_.reanchor_on_search) reanchor(gray);
   spread_level_ = searchLevel(gray.size());
   spread_wanted_ = params_.max_features - static_cast<int>(current_.size());
-  spread_live_.clear();
-  for (const auto& p : current_) spread_live_.push_back(p.uv);
+  positionsOf(current_, spread_live_);
   spread_image_ = pyramid_now_;
   spread_part_ = 0;
   responseBand(spread_part_++);
@@ -473,9 +478,7 @@ void FeatureTracker::startSpreadSearch(const cv::Mat& gray) {
 
 // Band b of responseBands() of the kept search image's response.
 void FeatureTracker::responseBand(int b) {
-  const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
-  const size_t per_level = kept.size() / (levels_built_ + 1);
-  const cv::Mat& level_image = kept[spread_level_ * per_level];
+  const cv::Mat& level_image = levelImage(pyramids_[spread_image_], spread_level_);
   const int bands = responseBands();
   cornerResponseRows(level_image, params_.block_size, bandTop(b, level_image.rows, bands),
                      bandTop(b + 1, level_image.rows, bands), spread_response_, response_rows_);
@@ -492,10 +495,9 @@ void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
   }
   const std::vector<cv::Mat>& kept = pyramids_[spread_image_];
   if (part == bands) {
-    const size_t per_level = kept.size() / (levels_built_ + 1);
-    spread_corners_ = findCorners(kept[0], kept[spread_level_ * per_level], spread_level_,
+    spread_corners_ = findCorners(kept[0], levelImage(kept, spread_level_), spread_level_,
                                   spread_live_, spread_wanted_, params_, search_buffers_,
-                                  per_level == 2 ? &kept[1] : nullptr, &spread_response_);
+                                  fullDerivatives(kept), &spread_response_);
     noteSearchLevel(spread_level_);
     // With three images or more, the corners are adopted on the next one.
     if (params_.search_spread_images >= 3) return;
@@ -506,14 +508,8 @@ void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
   std::vector<cv::Point2f>& followed = fresh_uv_;
   followed.clear();
   if (!corners.empty()) {
-    const cv::Size window = lkWindow(params_);
-    const cv::TermCriteria criteria = lkCriteria(params_);
-    cv::calcOpticalFlowPyrLK(kept, pyramid, corners, spread_to_, spread_status_, error_, window,
-                             fullLevel(), criteria, 0, params_.min_eigen_threshold);
-    if (params_.forward_backward_check)
-      cv::calcOpticalFlowPyrLK(pyramid, kept, spread_to_, spread_back_, spread_back_status_,
-                               error_, window, fullLevel(), criteria, 0,
-                               params_.min_eigen_threshold);
+    fullPass(kept, pyramid, corners, spread_to_, spread_status_, spread_back_,
+             spread_back_status_);
     const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
     for (size_t c = 0; c < corners.size(); ++c) {
       if (!spread_status_[c] || !inside(spread_to_[c], gray.size())) continue;

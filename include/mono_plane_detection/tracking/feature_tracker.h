@@ -169,6 +169,10 @@ class FeatureTracker {
                          const std::vector<cv::Mat>& pyramid, const cv::Size& size);
   void checkBackward(const std::vector<cv::Mat>& previous_pyramid,
                      const std::vector<cv::Mat>& pyramid);
+  void fullPass(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+                const std::vector<cv::Point2f>& from, std::vector<cv::Point2f>& to,
+                std::vector<uchar>& status, std::vector<cv::Point2f>& back,
+                std::vector<uchar>& back_status);
   void retryOnFullPyramid(const std::vector<cv::Mat>& previous_pyramid,
                           const std::vector<cv::Mat>& pyramid, const cv::Size& size);
   // Point i of previous_ was followed: tracked, inside, back within the check's bound.
@@ -179,6 +183,14 @@ class FeatureTracker {
   // image is too small to build them.
   int fullLevel() const {
     return std::min(std::max(0, params_.pyramid_levels - 1), levels_built_);
+  }
+  // A pyramid holds each level's image and, when built with them, its derivatives in turn.
+  const cv::Mat& levelImage(const std::vector<cv::Mat>& pyramid, int level) const {
+    return pyramid[level * (pyramid.size() / (levels_built_ + 1))];
+  }
+  // Full resolution's derivatives (CV_16SC2), null when the pyramid has none.
+  const cv::Mat* fullDerivatives(const std::vector<cv::Mat>& pyramid) const {
+    return pyramid.size() / (levels_built_ + 1) == 2 ? &pyramid[1] : nullptr;
   }
   void search(const cv::Mat& gray, const std::vector<cv::Mat>& pyramid);
   int searchLevel(const cv::Size& size) const;
@@ -211,8 +223,7 @@ class FeatureTracker {
   // no image memory.
   std::vector<cv::Mat> pyramids_[3];
   int pyramid_now_ = 0;
-  int pyramid_previous_ = -1;
-  bool has_previous_pyramid_ = false;
+  int pyramid_previous_ = -1;  // -1: none yet
   int levels_built_ = 0;
   // A spread search in progress (spread_part_ > 0: images of it done so far).
   int spread_image_ = -1;  // its search image's pyramid, -1: none
