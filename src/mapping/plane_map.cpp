@@ -260,6 +260,7 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
     }
   }
   mergeDuplicates(viewpoint);
+  dropExplained();
   fadeAndBound(stamp);
   // A merge may have renamed a plane an observation went to.
   for (int& id : ids) {
@@ -283,6 +284,7 @@ int PlaneMap::addKnownPlane(const PlaneObservation& obs, double stamp) {
   }
   const int id = fuse(kept, fit.normal, fit.distance, stamp);
   mergeDuplicates(obs.viewpoint);
+  dropExplained();
   fadeAndBound(stamp);
   return id;
 }
@@ -453,6 +455,46 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
         ++j;
       }
     }
+  }
+}
+
+// A plane of points that larger confirmed planes explain adds no surface of its own: a
+// mixture of two surfaces (a wall and the shelf before it) that one image's vote put
+// together and a tilted plane fits (two strips always lie on one plane). It goes when
+// fewer than min_points of its points are on no other plane and at least kStrip are on
+// each of two others: what is left would not be taken as a plane, and it is two others'
+// strips. (A true face keeps most of its points off the others: only its edges are on
+// them. A floor seen as a strip along one wall is on that wall alone, and stays.) A point
+// is on another plane within that plane's coplanar_sigmas x rms, in [min_residual_m,
+// max_residual_m].
+void PlaneMap::dropExplained() {
+  constexpr int kStrip = 3;  // points: the fewest that make a strip's line
+  std::map<int, int> on;     // plane id -> points of this plane on it
+  for (size_t i = 0; i < planes_.size();) {
+    const MapPlane& plane = planes_[i];
+    int own = 0;
+    on.clear();
+    for (const auto& [id, entry] : plane.points) {
+      if (own >= params_.min_points) break;  // kept whatever the rest is
+      const cv::Vec3d& x = entry.first;
+      const auto other = std::find_if(planes_.begin(), planes_.end(), [&](const MapPlane& q) {
+        if (q.id == plane.id || !q.confirmed(params_) || q.points.size() <= plane.points.size())
+          return false;
+        const double tolerance = std::clamp(params_.coplanar_sigmas * q.rms_m,
+                                            params_.min_residual_m, params_.max_residual_m);
+        return std::abs(q.own_normal.dot(x) - q.own_distance) <= tolerance;
+      });
+      if (other == planes_.end())
+        ++own;
+      else
+        ++on[other->id];
+    }
+    const auto strips = std::count_if(on.begin(), on.end(),
+                                      [&](const auto& entry) { return entry.second >= kStrip; });
+    if (own < params_.min_points && strips >= 2)
+      planes_.erase(planes_.begin() + static_cast<long>(i));
+    else
+      ++i;
   }
 }
 

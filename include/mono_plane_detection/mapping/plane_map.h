@@ -138,6 +138,10 @@ class PlaneMap {
   // `merged`: the id of a plane merged into this one (not a reference for it).
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged = -1) const;
   void mergeDuplicates(const cv::Vec3d& viewpoint);
+  // Removes the planes whose points larger confirmed planes explain (a mixture of two of
+  // their surfaces): fewer than min_points on no other plane, and a strip of them on
+  // each of two others.
+  void dropExplained();
   void fadeAndBound(double stamp);
 
   MapParams params_;
