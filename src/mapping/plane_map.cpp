@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include "mono_plane_detection/geometry/plane_fit.h"
@@ -262,7 +263,7 @@ std::vector<int> PlaneMap::update(const std::vector<PlaneObservation>& observati
   mergeDuplicates(viewpoint);
   dropExplained();
   fadeAndBound(stamp);
-  // A merge may have renamed a plane an observation went to.
+  // A merge may have renamed a plane an observation went to, or a mixture gone.
   for (int& id : ids) {
     if (id < 0) continue;
     const bool alive =
@@ -286,7 +287,9 @@ int PlaneMap::addKnownPlane(const PlaneObservation& obs, double stamp) {
   mergeDuplicates(obs.viewpoint);
   dropExplained();
   fadeAndBound(stamp);
-  return id;
+  const bool alive =
+      std::any_of(planes_.begin(), planes_.end(), [&](const MapPlane& p) { return p.id == id; });
+  return alive ? id : -1;
 }
 
 int PlaneMap::fuse(const PlaneObservation& kept, const cv::Vec3d& normal, double distance,
@@ -459,43 +462,78 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
 }
 
 // A plane of points that larger confirmed planes explain adds no surface of its own: a
-// mixture of two surfaces (a wall and the shelf before it) that one image's vote put
-// together and a tilted plane fits (two strips always lie on one plane). It goes when
-// fewer than min_points of its points are on no other plane and at least kStrip are on
-// each of two others: what is left would not be taken as a plane, and it is two others'
-// strips. (A true face keeps most of its points off the others: only its edges are on
-// them. A floor seen as a strip along one wall is on that wall alone, and stays.) A point
-// is on another plane within that plane's coplanar_sigmas x rms, in [min_residual_m,
-// max_residual_m].
+// mixture of two surfaces nearly parallel to it (a wall and the shelf before it) that one
+// image's vote put together and a tilted plane fits (two parallel strips always lie on
+// one plane). It goes when fewer than min_points of its points are on no larger confirmed
+// plane and at least kStrip are on each of two of them within 45 deg of it: what is left
+// would not be taken as a plane, and it is two others' strips. A true face keeps most of
+// its points off the others (only its edges are on them), and the surfaces its edges
+// touch are across it: a floor along one wall's foot or into a corner, a ceiling along
+// two corridor walls, a table top between two walls stay. Each point goes to the plane
+// it is nearest to in units of that plane's tolerance (coplanar_sigmas x rms, in
+// [min_residual_m, max_residual_m]). Largest first, so that a plane's fate is decided
+// before it explains smaller ones.
 void PlaneMap::dropExplained() {
-  constexpr int kStrip = 3;  // points: the fewest that make a strip's line
-  std::map<int, int> on;     // plane id -> points of this plane on it
-  for (size_t i = 0; i < planes_.size();) {
-    const MapPlane& plane = planes_[i];
+  constexpr int kStrip = 3;                // points: the fewest that show a strip's line
+  constexpr double kNearParallelDeg = 45;  // nearer parallel than at right angles
+  struct Explainer {
+    cv::Vec3d normal;
+    double distance, tolerance;
+    bool near_parallel;  // to the plane tested
+  };
+  std::vector<size_t> order(planes_.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return planes_[a].points.size() > planes_[b].points.size();
+  });
+  std::vector<bool> dropped(planes_.size(), false);
+  std::vector<Explainer> explainers;
+  std::vector<int> on;  // per explainer: the tested plane's points on it
+  for (size_t k = 0; k < order.size(); ++k) {
+    const MapPlane& plane = planes_[order[k]];
+    explainers.clear();
+    int near_parallel = 0;
+    for (size_t j = 0; j < k; ++j) {
+      const MapPlane& other = planes_[order[j]];
+      if (dropped[order[j]] || !other.confirmed(params_) ||
+          other.points.size() <= plane.points.size())
+        continue;
+      const double angle = normalAngleDeg(plane.own_normal, other.own_normal);
+      const bool parallel = std::min(angle, 180 - angle) < kNearParallelDeg;
+      near_parallel += parallel;
+      explainers.push_back({other.own_normal, other.own_distance,
+                            std::clamp(params_.coplanar_sigmas * other.rms_m,
+                                       params_.min_residual_m, params_.max_residual_m),
+                            parallel});
+    }
+    if (near_parallel < 2) continue;
+    on.assign(explainers.size(), 0);
     int own = 0;
-    on.clear();
     for (const auto& [id, entry] : plane.points) {
       if (own >= params_.min_points) break;  // kept whatever the rest is
-      const cv::Vec3d& x = entry.first;
-      const auto other = std::find_if(planes_.begin(), planes_.end(), [&](const MapPlane& q) {
-        if (q.id == plane.id || !q.confirmed(params_) || q.points.size() <= plane.points.size())
-          return false;
-        const double tolerance = std::clamp(params_.coplanar_sigmas * q.rms_m,
-                                            params_.min_residual_m, params_.max_residual_m);
-        return std::abs(q.own_normal.dot(x) - q.own_distance) <= tolerance;
-      });
-      if (other == planes_.end())
+      int nearest = -1;
+      double nearest_ratio = 1;
+      for (size_t e = 0; e < explainers.size(); ++e) {
+        const double ratio =
+            std::abs(explainers[e].normal.dot(entry.first) - explainers[e].distance) /
+            explainers[e].tolerance;
+        if (ratio <= nearest_ratio) {
+          nearest = static_cast<int>(e);
+          nearest_ratio = ratio;
+        }
+      }
+      if (nearest < 0)
         ++own;
       else
-        ++on[other->id];
+        ++on[nearest];
     }
-    const auto strips = std::count_if(on.begin(), on.end(),
-                                      [&](const auto& entry) { return entry.second >= kStrip; });
-    if (own < params_.min_points && strips >= 2)
-      planes_.erase(planes_.begin() + static_cast<long>(i));
-    else
-      ++i;
+    int strips = 0;
+    for (size_t e = 0; e < explainers.size(); ++e)
+      strips += explainers[e].near_parallel && on[e] >= kStrip;
+    dropped[order[k]] = own < params_.min_points && strips >= 2;
   }
+  for (size_t i = planes_.size(); i-- > 0;)
+    if (dropped[i]) planes_.erase(planes_.begin() + static_cast<long>(i));
 }
 
 void PlaneMap::fadeAndBound(double stamp) {

@@ -139,8 +139,8 @@ class PlaneMap {
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged = -1) const;
   void mergeDuplicates(const cv::Vec3d& viewpoint);
   // Removes the planes whose points larger confirmed planes explain (a mixture of two of
-  // their surfaces): fewer than min_points on no other plane, and a strip of them on
-  // each of two others.
+  // their surfaces): fewer than min_points on none of them, and a strip of them on each
+  // of two within 45 deg of the plane.
   void dropExplained();
   void fadeAndBound(double stamp);
 
