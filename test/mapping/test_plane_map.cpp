@@ -250,7 +250,7 @@ TEST(PlaneMap, APlaneOfPointsThatLargerPlanesExplainIsDropped) {
   ASSERT_EQ(map.planes().size(), 2u);
   for (const MapPlane& p : map.planes()) ASSERT_TRUE(p.confirmed(map.params()));
   // A strip of each (no uncertainties given: one plane fits them, as in
-  // TwoStripsOnParallelSurfacesAreNotOneTiltedPlane's old rule), seen twice.
+  // TwoStripsOnParallelSurfacesAreNotOneTiltedPlane's old rule).
   PlaneObservation mixture;
   mixture.viewpoint = {1.0, 0.3, 1.0};
   std::mt19937 rng(5);
@@ -261,13 +261,38 @@ TEST(PlaneMap, APlaneOfPointsThatLargerPlanesExplainIsDropped) {
     mixture.points.push_back({shelf ? 2.65 : 3.0, up(rng), (shelf ? 0.0 : 0.7) + width(rng)});
   }
   const double stamp = 1001;
+  const PlaneMap walls = map;
   const std::vector<int> ids = map.update({mixture}, stamp);
   EXPECT_EQ(ids[0], -1);
   EXPECT_EQ(map.planes().size(), 2u);
   for (const MapPlane& p : map.planes())
     EXPECT_LT(normalAngleDeg(p.normal, across), 2.0) << "plane " << p.id;
-  // The same points alone (no planes to explain them) are a plane, tilted: what was
-  // mapped. Confirmed from 3 views before the wall and shelf were mapped (as in the run),
+  // Not mixtures, and kept: the two strips with 6 points of their own between the two
+  // surfaces (a panel from the shelf to the wall), and the wall's strip alone with 4.
+  const auto onTheTiltedPlane = [&](int id) {
+    const double z = std::uniform_real_distribution<double>(0.2, 0.5)(rng);
+    return std::make_pair(std::uint64_t(id), cv::Vec3d(2.65 + 0.35 * (z - 0.04) / 0.7, up(rng), z));
+  };
+  PlaneObservation panel = mixture, leaning;
+  leaning.viewpoint = mixture.viewpoint;
+  for (size_t i = 1; i < mixture.points.size(); i += 2) {
+    leaning.ids.push_back(mixture.ids[i]);
+    leaning.points.push_back(mixture.points[i]);
+  }
+  for (int i = 0; i < 6; ++i) {
+    const auto [id, x] = onTheTiltedPlane(6000 + i);
+    panel.ids.push_back(id);
+    panel.points.push_back(x);
+    if (i >= 4) continue;
+    leaning.ids.push_back(id);
+    leaning.points.push_back(x);
+  }
+  for (const PlaneObservation& surface : {panel, leaning}) {
+    PlaneMap with = walls;
+    EXPECT_GE(with.update({surface}, stamp)[0], 0) << surface.points.size() << " points";
+    EXPECT_EQ(with.planes().size(), 3u) << surface.points.size() << " points";
+  }
+  // The mixture alone (no planes to explain it) is a plane, tilted: what was mapped. Confirmed from 3 views before the wall and shelf were mapped (as in the run),
   // it goes once they are confirmed.
   PlaneMap first;
   for (unsigned k = 0; k < 3; ++k) {
@@ -290,11 +315,10 @@ TEST(PlaneMap, APlaneOfPointsThatLargerPlanesExplainIsDropped) {
 }
 
 // True surfaces next to confirmed walls stay: a floor seen as a strip along the front
-// wall's foot (7 of its 10 points on the wall's plane: one plane explains them, not two),
-// a floor into the corner of two walls (4 points along each wall's foot, 4 of its own:
-// the walls are across it, not strips of surfaces it mixes), and a table top in that
-// corner whose edges lie on both walls (3 points on each) but whose own points (6) make
-// a plane.
+// wall's foot (7 of its 10 points on the wall's plane), a floor into the corner of two
+// walls (4 points along each wall's foot, 4 of its own), and a table top in that corner
+// (3 points on each wall, 6 of its own): the walls their edges touch are across them, not
+// surfaces nearly parallel to them that they would mix.
 TEST(PlaneMap, TrueSurfacesBesideConfirmedWallsStay) {
   const cv::Vec3d side(1, 0, 0);
   const auto withWalls = [&] {
@@ -307,47 +331,28 @@ TEST(PlaneMap, TrueSurfacesBesideConfirmedWallsStay) {
     for (const MapPlane& p : map.planes()) EXPECT_TRUE(p.confirmed(map.params()));
     return map;
   };
+  // A horizontal surface at `height`: points along the front wall's line, along the side
+  // wall's, and its own inside the corner.
   std::mt19937 rng(6);
-  std::uniform_real_distribution<double> along(0.5, 1.5), foot(0.0, 0.02), deep(0.3, 0.6),
-      edge(0.2, 0.8), inside(0.2, 0.6);
-  PlaneObservation floor;
-  floor.viewpoint = {1.0, 0.5, 2.0};
-  for (int i = 0; i < 10; ++i) {
-    floor.ids.push_back(7000 + i);
-    floor.points.push_back({along(rng), -0.8, i < 7 ? foot(rng) : deep(rng)});
+  std::uniform_real_distribution<double> edge(0.2, 0.8), foot(0.0, 0.02), inside(0.2, 0.6);
+  const auto horizontal = [&](double height, int on_front, int on_side, int own) {
+    PlaneObservation obs;
+    obs.viewpoint = {1.0, height + 1.3, 2.0};
+    for (int i = 0; i < on_front + on_side + own; ++i) {
+      obs.ids.push_back(7000 + i);
+      obs.points.push_back(i < on_front             ? cv::Vec3d(edge(rng), height, foot(rng))
+                           : i < on_front + on_side ? cv::Vec3d(foot(rng), height, edge(rng))
+                                                    : cv::Vec3d(inside(rng), height, inside(rng)));
+    }
+    return obs;
+  };
+  for (const PlaneObservation& surface :
+       {horizontal(-0.8, 7, 0, 3), horizontal(-0.8, 4, 4, 4), horizontal(0.8, 3, 3, 6)}) {
+    PlaneMap map = withWalls();
+    EXPECT_GE(map.update({surface}, 1001)[0], 0);
+    ASSERT_EQ(map.planes().size(), 3u);
+    EXPECT_LT(normalAngleDeg(map.planes()[2].normal, kFloor), 2.0);
   }
-  PlaneMap map = withWalls();
-  EXPECT_GE(map.update({floor}, 1001)[0], 0);
-  ASSERT_EQ(map.planes().size(), 3u);
-  EXPECT_LT(normalAngleDeg(map.planes()[2].normal, kFloor), 2.0);
-
-  PlaneObservation corner;
-  corner.viewpoint = {1.0, 0.5, 2.0};
-  for (int i = 0; i < 12; ++i) {
-    corner.ids.push_back(9000 + i);
-    const cv::Vec3d p = i < 4   ? cv::Vec3d(edge(rng), -0.8, foot(rng))   // front wall's foot
-                        : i < 8 ? cv::Vec3d(foot(rng), -0.8, edge(rng))   // side wall's foot
-                                : cv::Vec3d(inside(rng), -0.8, inside(rng));
-    corner.points.push_back(p);
-  }
-  map = withWalls();
-  EXPECT_GE(map.update({corner}, 1001)[0], 0);
-  ASSERT_EQ(map.planes().size(), 3u);
-  EXPECT_LT(normalAngleDeg(map.planes()[2].normal, kFloor), 2.0);
-
-  PlaneObservation table;
-  table.viewpoint = {1.0, 1.8, 2.0};
-  for (int i = 0; i < 12; ++i) {
-    table.ids.push_back(8000 + i);
-    const cv::Vec3d p = i < 3   ? cv::Vec3d(edge(rng), 0.8, foot(rng))   // on the front wall
-                        : i < 6 ? cv::Vec3d(foot(rng), 0.8, edge(rng))   // on the side wall
-                                : cv::Vec3d(inside(rng), 0.8, inside(rng));
-    table.points.push_back(p);
-  }
-  map = withWalls();
-  EXPECT_GE(map.update({table}, 1001)[0], 0);
-  ASSERT_EQ(map.planes().size(), 3u);
-  EXPECT_LT(normalAngleDeg(map.planes()[2].normal, kFloor), 2.0);
 }
 
 // Sparse landmarks of one wall in two bands (0.35 m high, 0.4 m apart, 15 points each,
