@@ -32,6 +32,20 @@ PlaneObservation observe(const cv::Vec3d& n, double d, std::uint64_t first_id, i
 
 const cv::Vec3d kFloor(0, 1, 0), kWall(0, 0, 1);
 
+// `count` points alternately on two vertical strips 8 cm wide, 1.5 m high (along z): a
+// shelf front at x = shelf_x, 0.7-0.78 m along y, and the wall at x = wall_x, 0-0.08 m.
+PlaneObservation twoStrips(double shelf_x, double wall_x, int count, std::uint64_t first_id,
+                           std::mt19937& rng) {
+  std::uniform_real_distribution<double> across(0, 0.08), up(0, 1.5);
+  PlaneObservation obs;
+  for (int i = 0; i < count; ++i) {
+    const bool shelf = i % 2 == 0;
+    obs.ids.push_back(first_id + i);
+    obs.points.push_back({shelf ? shelf_x : wall_x, (shelf ? 0.7 : 0.0) + across(rng), up(rng)});
+  }
+  return obs;
+}
+
 }  // namespace
 
 TEST(PlaneMap, TwoPlanesKeepTheirIdsOverTime) {
@@ -213,15 +227,9 @@ TEST(PlaneMap, MixturesAreSplitAtTheLandmarksUncertainty) {
 // lie on one tilted plane through both (two parallel lines always do). That plane
 // is not taken; without it (the old rule) a plane tilted by tens of degrees was mapped.
 TEST(PlaneMap, TwoStripsOnParallelSurfacesAreNotOneTiltedPlane) {
-  PlaneObservation obs;
-  obs.viewpoint = {2.0, 0.3, 1.0};
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> across(0, 0.08), up(0, 1.5);
-  for (int i = 0; i < 40; ++i) {
-    const bool shelf = i % 2 == 0;
-    obs.ids.push_back(100 + i);
-    obs.points.push_back({shelf ? 0.35 : 0.0, (shelf ? 0.7 : 0.0) + across(rng), up(rng)});
-  }
+  PlaneObservation obs = twoStrips(0.35, 0.0, 40, 100, rng);
+  obs.viewpoint = {2.0, 0.3, 1.0};
   PlaneMap old_rule;
   ASSERT_GE(old_rule.update({obs}, 1000)[0], 0);  // no uncertainties: one plane
   const double tilt = normalAngleDeg(old_rule.planes()[0].normal, cv::Vec3d(1, 0, 0));
@@ -251,15 +259,9 @@ TEST(PlaneMap, APlaneOfPointsThatLargerPlanesExplainIsDropped) {
   for (const MapPlane& p : map.planes()) ASSERT_TRUE(p.confirmed(map.params()));
   // A strip of each (no uncertainties given: one plane fits them, as in
   // TwoStripsOnParallelSurfacesAreNotOneTiltedPlane's old rule).
-  PlaneObservation mixture;
-  mixture.viewpoint = {1.0, 0.3, 1.0};
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> width(0, 0.08), up(0, 1.5);
-  for (int i = 0; i < 14; ++i) {
-    const bool shelf = i % 2 == 0;
-    mixture.ids.push_back(5000 + i);
-    mixture.points.push_back({shelf ? 2.65 : 3.0, up(rng), (shelf ? 0.0 : 0.7) + width(rng)});
-  }
+  PlaneObservation mixture = twoStrips(2.65, 3.0, 14, 5000, rng);
+  mixture.viewpoint = {1.0, 0.3, 1.0};
   const double stamp = 1001;
   const PlaneMap walls = map;
   const std::vector<int> ids = map.update({mixture}, stamp);
@@ -270,8 +272,9 @@ TEST(PlaneMap, APlaneOfPointsThatLargerPlanesExplainIsDropped) {
   // Not mixtures, and kept: the two strips with 6 points of their own between the two
   // surfaces (a panel from the shelf to the wall), and the wall's strip alone with 4.
   const auto onTheTiltedPlane = [&](int id) {
-    const double z = std::uniform_real_distribution<double>(0.2, 0.5)(rng);
-    return std::make_pair(std::uint64_t(id), cv::Vec3d(2.65 + 0.35 * (z - 0.04) / 0.7, up(rng), z));
+    const double y = std::uniform_real_distribution<double>(0.2, 0.5)(rng);
+    const double z = std::uniform_real_distribution<double>(0, 1.5)(rng);
+    return std::make_pair(std::uint64_t(id), cv::Vec3d(3.0 - 0.35 * (y - 0.04) / 0.7, y, z));
   };
   PlaneObservation panel = mixture, leaning;
   leaning.viewpoint = mixture.viewpoint;
