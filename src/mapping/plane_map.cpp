@@ -501,9 +501,10 @@ void PlaneMap::dropExplained() {
       const double angle = normalAngleDeg(plane.own_normal, other.own_normal);
       const bool parallel = std::min(angle, 180 - angle) < kNearParallelDeg;
       near_parallel += parallel;
+      const double tolerance = std::clamp(params_.coplanar_sigmas * other.rms_m,
+                                          params_.min_residual_m, params_.max_residual_m);
       explainers.push_back({other.own_normal, other.own_distance,
-                            std::clamp(params_.coplanar_sigmas * other.rms_m,
-                                       params_.min_residual_m, params_.max_residual_m),
+                            std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
                             parallel});
     }
     if (near_parallel < 2) continue;
