@@ -60,7 +60,9 @@ int main(int argc, char** argv) {
       "  then prints each mapped plane against the ground truth and the camera path error,\n"
       "  and how far off the metric start put the camera's orientation (the tilt the map\n"
       "  inherits from the start-up target; not with camera_height, whose map has its own\n"
-      "  heading).",
+      "  heading). Planes the map holds but has not confirmed (too few views, a normal\n"
+      "  known worse than map/max_normal_sigma_deg) are listed as tentative, with the\n"
+      "  surface they match: a missed plane the map was still confirming shows there.",
       "exit codes: 0 every true plane mapped once, 1 a plane missed or split, 2 bad usage\n");
   RoomParams room;
   std::string textures, save_dir, top_view;
@@ -284,18 +286,21 @@ int main(int argc, char** argv) {
         "travelled %.2f m (max error %.1f %% of it)\n",
         posed, frames, posed ? pos_err_sum / posed : 0.0, pos_err_max, travelled,
         travelled > 0 ? 100 * pos_err_max / travelled : 0.0);
-    std::vector<MapPlane> confirmed;
+    // Tentative planes are judged apart: they tell a missed plane the map was still
+    // confirming (too few views, a loose normal) from one it never held.
+    std::vector<MapPlane> confirmed, tentative;
     for (const MapPlane& p : pipeline.map().planes())
-      if (p.confirmed(pipeline.map().params())) confirmed.push_back(p);
+      (p.confirmed(pipeline.map().params()) ? confirmed : tentative).push_back(p);
     std::vector<TruthPlane> judged = truth;
     if (truth_from_map) {
       // Distances from the first camera position (the target frame's origin is 20 m up).
       const cv::Vec3d shift = -truth_map.front();
-      for (MapPlane& p : confirmed) {
-        p.normal = truth_from_map->R * p.normal;
-        p.distance += p.normal.dot(truth_from_map->t) + p.normal.dot(shift);
-        for (cv::Vec3d& v : p.polygon) v = truth_from_map->apply(v);
-      }
+      for (std::vector<MapPlane>* planes : {&confirmed, &tentative})
+        for (MapPlane& p : *planes) {
+          p.normal = truth_from_map->R * p.normal;
+          p.distance += p.normal.dot(truth_from_map->t) + p.normal.dot(shift);
+          for (cv::Vec3d& v : p.polygon) v = truth_from_map->apply(v);
+        }
       for (size_t t = 0; t < judged.size(); ++t) {
         judged[t].distance += judged[t].normal.dot(shift);
         judged[t].range_m = std::abs(judged[t].distance);
@@ -339,6 +344,18 @@ int main(int argc, char** argv) {
       for (const auto& [name, count] : made_of) std::printf(" %s %d", name.c_str(), count);
       std::printf("\n");
     }
+    const MapEvaluation tentative_eval =
+        evaluateMap(tentative, judged, truth_from_map ? 0.15 : 0.10);
+    for (size_t i = 0; i < tentative.size(); ++i) {
+      const MapPlane& p = tentative[i];
+      const PlaneMatch& m = tentative_eval.matches[i];
+      std::printf("  tentative plane %d: %zu points, %d views, normal sigma %.2f deg -> %s", p.id,
+                  p.points.size(), p.observations, p.normal_sigma_deg,
+                  m.truth_id >= 0 ? m.truth_name.c_str() : "NO MATCH");
+      if (m.truth_id >= 0)
+        std::printf(" (normal %.2f deg, distance %.3f m)", m.normal_error_deg, m.distance_error_m);
+      std::printf("\n");
+    }
     for (const TruthPlane& t : truth)
       if (t.max_image_share >= 0.02)
         std::printf("  truth %s: n=(%.2f %.2f %.2f) d=%.3f, max share %.0f %%\n", t.name.c_str(),
@@ -346,7 +363,11 @@ int main(int argc, char** argv) {
     int false_planes = 0;
     for (const PlaneMatch& m : eval.matches) false_planes += m.truth_id < 0;
     std::printf("false planes %d\n", false_planes);
-    for (int id : eval.missed) std::printf("  missed: true plane %d\n", id);
+    for (int id : eval.missed) {
+      const auto t = std::find_if(judged.begin(), judged.end(),
+                                  [&](const TruthPlane& j) { return j.id == id; });
+      std::printf("  missed: true plane %d (%s)\n", id, t != judged.end() ? t->name.c_str() : "?");
+    }
     std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
                 eval.worst_distance_error_m);
