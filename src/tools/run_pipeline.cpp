@@ -292,9 +292,13 @@ int main(int argc, char** argv) {
     for (const MapPlane& p : pipeline.map().planes())
       (p.confirmed(pipeline.map().params()) ? confirmed : tentative).push_back(p);
     std::vector<TruthPlane> judged = truth;
+    // Distances from the first camera position (the target frame's origin is 20 m up).
+    const cv::Vec3d shift = truth_from_map ? cv::Vec3d(-truth_map.front()) : cv::Vec3d(0, 0, 0);
+    // A map point in the frame the planes are judged in.
+    const auto judgedFrame = [&](const cv::Vec3d& x) {
+      return truth_from_map ? cv::Vec3d(truth_from_map->apply(x) + shift) : x;
+    };
     if (truth_from_map) {
-      // Distances from the first camera position (the target frame's origin is 20 m up).
-      const cv::Vec3d shift = -truth_map.front();
       for (std::vector<MapPlane>* planes : {&confirmed, &tentative})
         for (MapPlane& p : *planes) {
           p.normal = truth_from_map->R * p.normal;
@@ -340,7 +344,22 @@ int main(int argc, char** argv) {
         }
         ++made_of[best];
       }
-      std::printf("    normal sigma %.2f deg, rms %.3f m; points on:", p.normal_sigma_deg, p.rms_m);
+      // The distance error where the plane is (its points projected onto it), not at the
+      // map's origin, where a small normal error grows with the lever.
+      double at_points = 0;
+      const auto truth = std::find_if(judged.begin(), judged.end(),
+                                      [&](const TruthPlane& t) { return t.id == m.truth_id; });
+      if (truth != judged.end() && !p.points.empty()) {
+        for (const auto& [id, entry] : p.points) {
+          cv::Vec3d y = judgedFrame(entry.first);
+          y -= (p.normal.dot(y) - p.distance) * p.normal;
+          at_points += std::abs(truth->normal.dot(y) - truth->distance);
+        }
+        at_points /= static_cast<double>(p.points.size());
+      }
+      std::printf("    normal sigma %.2f deg, rms %.3f m, distance error at its points %.3f m; "
+                  "points on:",
+                  p.normal_sigma_deg, p.rms_m, at_points);
       for (const auto& [name, count] : made_of) std::printf(" %s %d", name.c_str(), count);
       std::printf("\n");
     }
