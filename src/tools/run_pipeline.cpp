@@ -347,13 +347,13 @@ int main(int argc, char** argv) {
       // The distance error where the plane is (its points projected onto it), not at the
       // map's origin, where a small normal error grows with the lever.
       double at_points = 0;
-      const auto truth = std::find_if(judged.begin(), judged.end(),
-                                      [&](const TruthPlane& t) { return t.id == m.truth_id; });
-      if (truth != judged.end() && !p.points.empty()) {
+      const auto matched = std::find_if(judged.begin(), judged.end(),
+                                        [&](const TruthPlane& t) { return t.id == m.truth_id; });
+      if (matched != judged.end() && !p.points.empty()) {
         for (const auto& [id, entry] : p.points) {
           cv::Vec3d y = judgedFrame(entry.first);
           y -= (p.normal.dot(y) - p.distance) * p.normal;
-          at_points += std::abs(truth->normal.dot(y) - truth->distance);
+          at_points += std::abs(matched->normal.dot(y) - matched->distance);
         }
         at_points /= static_cast<double>(p.points.size());
       }
@@ -383,9 +383,10 @@ int main(int argc, char** argv) {
     for (const PlaneMatch& m : eval.matches) false_planes += m.truth_id < 0;
     std::printf("false planes %d\n", false_planes);
     for (int id : eval.missed) {
-      const auto t = std::find_if(judged.begin(), judged.end(),
-                                  [&](const TruthPlane& j) { return j.id == id; });
-      std::printf("  missed: true plane %d (%s)\n", id, t != judged.end() ? t->name.c_str() : "?");
+      const auto missed = std::find_if(judged.begin(), judged.end(),
+                                       [&](const TruthPlane& t) { return t.id == id; });
+      std::printf("  missed: true plane %d (%s)\n", id,
+                  missed != judged.end() ? missed->name.c_str() : "?");
     }
     std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,
