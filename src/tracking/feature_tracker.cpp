@@ -258,11 +258,19 @@ void FeatureTracker::trackFromPrevious(const std::vector<cv::Mat>& previous_pyra
 }
 
 bool FeatureTracker::followed(size_t i, const cv::Size& size) const {
-  if (!status_[i] || !inside(after_[i], size)) return false;
+  const bool checked = params_.forward_backward_check;  // (back_ is stale without it)
+  return passedCheck(status_[i], after_[i], checked ? back_status_[i] : 0,
+                     checked ? back_[i] : before_[i], before_[i], size);
+}
+
+bool FeatureTracker::passedCheck(uchar status, const cv::Point2f& to, uchar back_status,
+                                 const cv::Point2f& back, const cv::Point2f& from,
+                                 const cv::Size& size) const {
+  if (!status || !inside(to, size)) return false;
   if (!params_.forward_backward_check) return true;
-  const cv::Point2f d = back_[i] - before_[i];
+  const cv::Point2f d = back - from;
   const double fb_max = params_.forward_backward_max_px;
-  return back_status_[i] && d.dot(d) <= fb_max * fb_max;
+  return back_status && d.dot(d) <= fb_max * fb_max;
 }
 
 // The full pass on kMotionSample points spread through previous_ (their results stay in
@@ -510,15 +518,11 @@ void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
   if (!corners.empty()) {
     fullPass(kept, pyramid, corners, spread_to_, spread_status_, spread_back_,
              spread_back_status_);
-    const double fb_max2 = params_.forward_backward_max_px * params_.forward_backward_max_px;
-    for (size_t c = 0; c < corners.size(); ++c) {
-      if (!spread_status_[c] || !inside(spread_to_[c], gray.size())) continue;
-      if (params_.forward_backward_check) {
-        const cv::Point2f d = spread_back_[c] - corners[c];
-        if (!spread_back_status_[c] || d.dot(d) > fb_max2) continue;
-      }
-      followed.push_back(spread_to_[c]);
-    }
+    const bool checked = params_.forward_backward_check;
+    for (size_t c = 0; c < corners.size(); ++c)
+      if (passedCheck(spread_status_[c], spread_to_[c], checked ? spread_back_status_[c] : 0,
+                      checked ? spread_back_[c] : corners[c], corners[c], gray.size()))
+        followed.push_back(spread_to_[c]);
   }
   spread_image_ = -1;
   spread_part_ = 0;
@@ -553,17 +557,16 @@ void FeatureTracker::adoptCorners(const cv::Mat& gray, const std::vector<cv::Poi
 
   // One ORB call for the live points and the new corners: the new corners' part is
   // compared with the lost points, and all are remembered for when they get lost.
+  // (descriptors[k] is current_[k]'s once the fresh points are appended.)
   std::vector<cv::Mat> descriptors;
-  described_.clear();
   if (params_.reidentify) {
-    selectLive();
+    positionsOf(current_, live_uv_);
     for (const auto& p : fresh) live_uv_.push_back(p.uv);
     descriptors = orbDescriptors(gray, live_uv_);
-    const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + described_.size(),
+    const std::vector<cv::Mat> fresh_descriptors(descriptors.begin() + current_.size(),
                                                  descriptors.end());
     reidentify(fresh_descriptors, fresh);
   }
-  const size_t first_fresh = current_.size();
   for (auto& p : fresh) {
     if (!p.is_reidentified) {
       p.id = next_id_++;
@@ -571,20 +574,7 @@ void FeatureTracker::adoptCorners(const cv::Mat& gray, const std::vector<cv::Poi
     }
     current_.push_back(p);
   }
-  if (params_.reidentify) {
-    for (size_t k = first_fresh; k < current_.size(); ++k)
-      described_.push_back(static_cast<int>(k));
-    refreshDescriptors(descriptors);
-  }
-}
-
-void FeatureTracker::selectLive() {
-  described_.clear();
-  live_uv_.clear();
-  for (size_t i = 0; i < current_.size(); ++i) {
-    described_.push_back(static_cast<int>(i));
-    live_uv_.push_back(current_[i].uv);
-  }
+  if (params_.reidentify) refreshDescriptors(descriptors);
 }
 
 // Lucas-Kanade with a translation-only window follows the centroid of the window's
@@ -594,14 +584,13 @@ void FeatureTracker::selectLive() {
 // over the images, a share of the points on each, was measured: errors grew by up to
 // half on real textures and the search image's time hardly changed.)
 void FeatureTracker::reanchor(const cv::Mat& gray) {
-  selectLive();
-  if (live_uv_.empty()) return;
-  std::vector<cv::Point2f>& refined = live_uv_;
+  std::vector<cv::Point2f>& refined = positionsOf(current_, live_uv_);
+  if (refined.empty()) return;
   const int half = params_.reanchor_window_px;
   cv::cornerSubPix(gray, refined, cv::Size(half, half), cv::Size(-1, -1), kSubPixCriteria);
   const double max_shift2 = params_.reanchor_max_shift_px * params_.reanchor_max_shift_px;
-  for (size_t k = 0; k < described_.size(); ++k) {
-    TrackedPoint& point = current_[described_[k]];
+  for (size_t k = 0; k < current_.size(); ++k) {
+    TrackedPoint& point = current_[k];
     const cv::Point2f d = refined[k] - point.uv;
     if (d.dot(d) <= max_shift2 && inside(refined[k], gray.size())) point.uv = refined[k];
   }
@@ -671,10 +660,10 @@ void FeatureTracker::reidentify(const std::vector<cv::Mat>& descriptors,
   lost_ = std::move(kept);
 }
 
-// descriptors[k] belongs to current_[described_[k]]; the other live points keep theirs.
+// descriptors[k] belongs to current_[k].
 void FeatureTracker::refreshDescriptors(const std::vector<cv::Mat>& descriptors) {
-  for (size_t k = 0; k < described_.size(); ++k) {
-    const std::uint64_t id = current_[described_[k]].id;
+  for (size_t k = 0; k < current_.size(); ++k) {
+    const std::uint64_t id = current_[k].id;
     if (descriptors[k].empty()) {
       descriptors_.erase(id);
     } else {

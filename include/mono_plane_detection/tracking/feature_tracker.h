@@ -177,6 +177,10 @@ class FeatureTracker {
                           const std::vector<cv::Mat>& pyramid, const cv::Size& size);
   // Point i of previous_ was followed: tracked, inside, back within the check's bound.
   bool followed(size_t i, const cv::Size& size) const;
+  // A point Lucas-Kanade took from `from` to `to` (status) inside the image, and, with the
+  // forward-backward check, back (back_status) within its bound of `from`.
+  bool passedCheck(uchar status, const cv::Point2f& to, uchar back_status,
+                   const cv::Point2f& back, const cv::Point2f& from, const cv::Size& size) const;
   int measureImageMotion(const std::vector<cv::Mat>& previous_pyramid,
                          const std::vector<cv::Mat>& pyramid, const cv::Size& size);
   // The top pyramid level Lucas-Kanade can use: pyramid_levels - 1, or fewer when the
@@ -204,8 +208,6 @@ class FeatureTracker {
   void responseBand(int band);
   void adoptCorners(const cv::Mat& gray, const std::vector<cv::Point2f>& corners);
   void reanchor(const cv::Mat& gray);
-  // described_ and live_uv_: every live point (indices into current_, positions).
-  void selectLive();
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
@@ -245,7 +247,6 @@ class FeatureTracker {
   std::vector<uchar> recheck_status_, recheck_back_status_;
   std::vector<cv::Point2f> recheck_to_;
   cv::Point2f image_motion_;  // predict_motion: the sample's median motion
-  std::vector<int> described_;  // indices into current_ of the points re-anchored / described
   std::vector<TrackedPoint> fresh_;
   CornerSearchBuffers search_buffers_;
   cv::Size image_size_;
