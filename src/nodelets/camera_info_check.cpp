@@ -168,6 +168,15 @@ const CameraIntrinsics* CalibrationHolder::forImages(const cv::Size& size,
   return heldFor(size);
 }
 
+std::string cameraModelName(const CalibrationHolder& calibration, const cv::Size& images) {
+  const CameraIntrinsics* held = calibration.heldFor(images);
+  return !calibration.latest()     ? "none"
+         : !held                   ? "not used: camera_info for another image size"
+         : held->rectified         ? "rectified (P)"
+         : !held->fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
+                                   : "raw (K, D)";
+}
+
 bool isRectifiedTopic(const std::string& topic) {
   const std::string base = topic.substr(topic.find_last_of('/') + 1);
   return base.rfind("image_rect", 0) == 0;

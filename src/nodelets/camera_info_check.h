@@ -80,6 +80,10 @@ class CalibrationHolder {
   std::optional<CameraIntrinsics> held_;    // the last one of the images' size
 };
 
+// The camera model a nodelet uses, for its diagnostics: "none", "not used: camera_info
+// for another image size", "rectified (P)", "equidistant (K, D via cv::fisheye)" or "raw (K, D)".
+std::string cameraModelName(const CalibrationHolder& calibration, const cv::Size& images);
+
 // A rectified stream by its topic's name: image_proc calls it image_rect (or image_rect_color).
 bool isRectifiedTopic(const std::string& resolved_image_topic);
 

@@ -886,12 +886,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     status.add("tracks messages dropped", dropped_);
     status.add("camera_info messages rejected", dropped_info_);
     // The calibration of the last tracks' size (before any: the last camera_info).
-    const CameraIntrinsics* held = calibration_.heldFor(last_tracks_size_);
-    status.add("camera model", !calibration_.latest()     ? "none"
-                               : !held                    ? "not used: camera_info for another image size"
-                               : held->rectified          ? "rectified (P)"
-                               : !held->fisheye_D.empty() ? "equidistant (K, D via cv::fisheye)"
-                                                          : "raw (K, D)");
+    status.add("camera model", cameraModelName(calibration_, last_tracks_size_));
     status.add("tf", !tf_conflict_.empty() ? "refused: " + tf_conflict_
                      : !publish_tf_        ? std::string("off")
                      : tf_edge_.empty()    ? std::string("nothing published yet")

@@ -71,6 +71,8 @@ class TrackerFrontEnd {
 
   const TrackerCounts& counts() const { return counts_; }
   bool hasCameraInfo() const { return calibration_.latest().has_value(); }
+  // The camera model the target is searched with (cameraModelName).
+  std::string cameraModel() const { return cameraModelName(calibration_, last_size_); }
   // A camera_info of the last image's size is used (the newest or an earlier one).
   bool hasCalibrationForImages() const { return calibration_.heldFor(last_size_) != nullptr; }
   // Now: the usable camera_info is for another size than the last image's ("" when it

@@ -53,10 +53,15 @@ class TrackerNodelet : public nodelet::Nodelet {
     TrackerNodeParams params;
     readParams(pnh, trackerNodeParamTable(), params, getName());
     front_ = TrackerFrontEnd(params);
-    // image_proc's rectified stream (image_rect*): P without distortion, as the plane
-    // nodelet reads it; else the raw image's K and D (the target is searched undistorted).
+    // Rectified images (said so, or image_proc's image_rect*): P without distortion, as
+    // the plane nodelet reads them; else the raw image's K and D (the target is searched
+    // undistorted).
     image_topic_ = nh.resolveName("image");
-    front_.setRectified(isRectifiedTopic(image_topic_));
+    const bool rectified = params.rectified || isRectifiedTopic(image_topic_);
+    front_.setRectified(rectified);
+    if (rectified)
+      NODELET_INFO("rectified images (%s): camera_info's P is used, without distortion",
+                   params.rectified ? "parameter rectified" : image_topic_.c_str());
 
     diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose, guard_,
                        params.expected_min_rate_hz, params.expected_max_rate_hz);
@@ -256,6 +261,7 @@ class TrackerNodelet : public nodelet::Nodelet {
                               : front_.hasCalibrationForImages() ? "the last of the images' size "
                                                                    "(the newest is for another size)"
                                                                  : "for another image size: not used");
+    status.add("camera model", front_.cameraModel());
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
     status.add("images with camera_info of another frame_id (total)", c.info_frame_mismatch);
     // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).

@@ -420,6 +420,9 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
     t.push_back({"detect_target", field(&P::detect_target), 0, 1, "",
                  "look for the start-up target (paper II-A) until found, then around its "
                  "tracked corners (target/redetect_tracked); false: neither"});
+    t.push_back({"rectified", field(&P::rectified), 0, 1, "",
+                 "the images are rectified: camera_info's P, no distortion, for the start-up "
+                 "target (also when the image topic is image_rect*)"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
                  "a longer pause between images (and over 3 of their periods) is a tracking loss "
                  "(start over)"});

@@ -113,6 +113,30 @@ TEST(CameraInfoCheck, RectifiedStreamsUsePWithoutDistortion) {
   EXPECT_FALSE(isRectifiedTopic("/image_rect_cam/image_raw"));
 }
 
+// What each nodelet's diagnostics say it uses ("camera model"): none before a camera_info,
+// then the model of the one held for the images' size.
+TEST(CameraInfoCheck, TheCameraModelIsNamedForDiagnostics) {
+  CalibrationHolder holder;
+  EXPECT_EQ(cameraModelName(holder, {640, 480}), "none");
+  sensor_msgs::CameraInfo info = cameraInfo({-0.3, 0.1, 0, 0, 0});
+  info.P = {450, 0, 300, 0, 0, 460, 230, 0, 0, 0, 1, 0};
+  const cv::Size size(static_cast<int>(info.width), static_cast<int>(info.height));
+  CameraIntrinsics camera;
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
+  holder.offer(camera);
+  EXPECT_EQ(cameraModelName(holder, size), "raw (K, D)");
+  EXPECT_EQ(cameraModelName(holder, {size.width / 2, size.height / 2}),
+            "not used: camera_info for another image size");
+  ASSERT_EQ(intrinsicsFromCameraInfo(info, true, camera), "");
+  holder.offer(camera);
+  EXPECT_EQ(cameraModelName(holder, size), "rectified (P)");
+  ASSERT_EQ(intrinsicsFromCameraInfo(cameraInfo({0.05, -0.01, 0.002, -0.0005}, "equidistant"),
+                                     false, camera),
+            "");
+  holder.offer(camera);
+  EXPECT_EQ(cameraModelName(holder, size), "equidistant (K, D via cv::fisheye)");
+}
+
 // Equidistant: the tracks are moved to the pinhole image of the same K with cv::fisheye;
 // points beyond it are dropped; other models are refused with one clear error.
 TEST(CameraInfoCheck, EquidistantThroughCvFisheye) {

@@ -50,7 +50,7 @@ TEST(ParamTable, DefaultsAreInRangeAndNamesUnique) {
   expectSound(poseParamTable());
   expectSound(mapParamTable());
   EXPECT_EQ(trackerNodeParamTable().size(),
-            trackerParamTable().size() + targetParamTable().size() + 7);  // + target_timeout_s
+            trackerParamTable().size() + targetParamTable().size() + 8);  // + node params, rectified
 }
 
 TEST(ParamTable, NestedNamesReachTheNestedFields) {

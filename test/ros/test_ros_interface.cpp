@@ -186,6 +186,18 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   EXPECT_TRUE(
       buffer.canTransform("rear_map", "rear_optical_estimate", ros::Time(0), ros::Duration(2.0)));
 
+  // Each nodelet says which camera model it uses: raw (K, D) for the front camera, P for
+  // the rear (image_rect) and the side (rectified:=true, which reaches both nodelets).
+  for (const auto& [camera, model] : std::map<std::string, std::string>{
+           {"front", "raw (K, D)"}, {"rear", "rectified (P)"}, {"side", "rectified (P)"}}) {
+    DiagnosticsProbe tracker(nh, camera + "/tracker: tracking");
+    DiagnosticsProbe planes(nh, camera + "/plane_detector: planes");
+    ASSERT_TRUE(tracker.waitFresh()) << camera;
+    ASSERT_TRUE(planes.waitFresh()) << camera;
+    EXPECT_EQ(tracker.value("camera model"), model) << camera << "'s tracker";
+    EXPECT_EQ(planes.value("camera model"), model) << camera << "'s plane detector";
+  }
+
   // Diagnostics under simulated time: the input rate and the node's own status are OK
   // during the replay, a pause shows, and after it they are OK again.
   DiagnosticsProbe rate(nh, "front/plane_detector: input rate");

@@ -145,6 +145,7 @@ struct TrackerNodeParams {
   TargetParams target;    // target/width_m, ...
   bool lazy = true;
   bool detect_target = true;
+  bool rectified = false;  // the images are rectified (P, no distortion)
   double max_gap_s = 1.0;
   double target_timeout_s = 30.0;  // WARN when images come this long without a target
   std::string image_transport = "raw";
