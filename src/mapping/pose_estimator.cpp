@@ -586,7 +586,7 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
   while (!floor_views_.empty() && pair(floor_views_.front()).ids.size() < needed)
     floor_views_.pop_front();
   // A new view is kept once the tracks have moved since the newest one (median image
-  // motion of 1 % of the focal length: a still camera adds none), at most 20 of them.
+  // motion of 1 % of the focal length: a still camera adds none), at most 40 of them.
   bool keep = floor_views_.empty();
   if (!keep) {
     const Pair p = pair(floor_views_.back());
