@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <tuple>
+
 #include "../../src/tools/profile.h"
 
 #include <dirent.h>
@@ -244,22 +246,30 @@ TEST(ParamTable, ConfigFilesUseKnownNamesInRange) {
 // next plain launch waited for odometry).
 TEST(ParamTable, ParamsLaunchFilesSetConditionallyAreInTheConfig) {
   const std::string dir = std::string(SOURCE_DIR);
-  std::vector<std::pair<std::string, YAML::Node>> keys;
-  flattenYaml(YAML::LoadFile(dir + "/config/planes.yaml"), "", keys);
-  std::set<std::string> in_config;
-  for (const auto& key : keys) in_config.insert(key.first);
-  std::ifstream launch(dir + "/launch/planes.launch");
-  ASSERT_TRUE(launch.good());
-  const std::string text((std::istreambuf_iterator<char>(launch)), std::istreambuf_iterator<char>());
-  int conditional = 0;
-  for (size_t at = text.find("<param if="); at != std::string::npos;
-       at = text.find("<param if=", at + 1)) {
-    const size_t name = text.find("name=\"", at) + 6;
-    const std::string param = text.substr(name, text.find('"', name) - name);
-    ++conditional;
-    EXPECT_TRUE(in_config.count(param)) << param << " is set only with its launch argument";
+  for (const auto& [launch_file, config, least] :
+       std::vector<std::tuple<std::string, std::string, int>>{
+           // pose/metric_source, pose/camera_height_m, odom_frame, map_frame, tf_mode, rectified
+           {"planes.launch", "planes.yaml", 6},
+           {"tracker.launch", "tracker.yaml", 3}}) {  // lazy, detect_target, rectified
+    std::vector<std::pair<std::string, YAML::Node>> keys;
+    flattenYaml(YAML::LoadFile(dir + "/config/" + config), "", keys);
+    std::set<std::string> in_config;
+    for (const auto& key : keys) in_config.insert(key.first);
+    std::ifstream launch(dir + "/launch/" + launch_file);
+    ASSERT_TRUE(launch.good()) << launch_file;
+    const std::string text((std::istreambuf_iterator<char>(launch)),
+                           std::istreambuf_iterator<char>());
+    int conditional = 0;
+    for (size_t at = text.find("<param if="); at != std::string::npos;
+         at = text.find("<param if=", at + 1)) {
+      const size_t name = text.find("name=\"", at) + 6;
+      const std::string param = text.substr(name, text.find('"', name) - name);
+      ++conditional;
+      EXPECT_TRUE(in_config.count(param))
+          << param << " is set only with its launch argument (" << launch_file << ")";
+    }
+    EXPECT_GE(conditional, least) << launch_file;
   }
-  EXPECT_GE(conditional, 2);  // pose/metric_source, pose/camera_height_m
 }
 
 // Issue 12: target_type and the marker's dictionary are names the ranges cannot check:
