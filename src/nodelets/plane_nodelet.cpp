@@ -482,12 +482,33 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
     std::string up = parent;  // no loop: the child must not be above the parent
     for (int depth = 0; depth < 64 && tf_buffer_->_getParent(up, ros::Time(0), existing); ++depth) {
-      if (existing == child)
-        return "'" + child + "' is above '" + parent + "' on tf: " + parent + " -> " + child +
-               " would make a loop";
+      if (existing == child) {
+        std::string why = "'" + child + "' is above '" + parent + "' on tf: " + parent +
+                          " -> " + child + " would make a loop";
+        // Our own earlier link, kept by every tf listener that heard it: a static parent
+        // of that frame sent after it was dropped by them (tf2's TF_OLD_DATA), so they
+        // would keep the loop. Only restarting them clears it.
+        const std::string ours = existing + " -> " + up;
+        if (published_edges_.count(ours))
+          why += " through this nodelet's earlier " + ours + ": tf listeners that heard it keep it" +
+                 staticParentNote(up) +
+                 ": restart the pipeline and the tf listeners (rviz) with tf_mode:=below_odom, or "
+                 "start the static publisher first";
+        return why;
+      }
       up = existing;
     }
     return {};
+  }
+
+  // ", and dropped the static parent 'p' of 'frame' sent after it" when /tf_static has one.
+  std::string staticParentNote(const std::string& frame) const {
+    std::lock_guard<std::mutex> lock(static_mutex_);
+    const auto it = static_parents_.find(frame);
+    return it == static_parents_.end()
+               ? std::string()
+               : ", and dropped the static parent '" + it->second + "' of '" + frame +
+                     "' sent after it (TF_OLD_DATA)";
   }
 
   // The one transform this nodelet publishes for this image, if any (mutex_ held).
@@ -502,8 +523,19 @@ class PlaneNodelet : public nodelet::Nodelet {
       // is never touched. No odometry for this image: nothing new to say.
       if (!odom) return {};
       if (resolved_tf_mode_.empty()) {
+        // A static parent first: tf2 drops one sent after a dynamic link to the same frame
+        // (ours, before a ~reset), so only /tf_static shows it (as to tfConflict).
         std::string odom_parent;
-        const bool has_parent = tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
+        bool has_parent = false;
+        {
+          std::lock_guard<std::mutex> lock(static_mutex_);
+          const auto it = static_parents_.find(odom_frame_);
+          if (it != static_parents_.end()) {
+            odom_parent = it->second;
+            has_parent = true;
+          }
+        }
+        if (!has_parent) has_parent = tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
         resolved_tf_mode_ = tf_mode_ != "auto"                             ? tf_mode_
                             : has_parent && odom_parent != map_frame_ ? "below_odom"
                                                                            : "above_odom";

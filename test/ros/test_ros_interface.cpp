@@ -9,6 +9,7 @@
 //    publishes map -> odom: the nodelet attaches odom -> plane_map instead. A second
 //    nodelet told to publish the camera's own frame refuses (ERROR in diagnostics).
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <std_srvs/Empty.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -367,10 +368,11 @@ TEST(TfTree, StaysATreeWithOdometry) {
   PlaneArrayConstPtr last;
   Pose truth_map_from_base;
   ros::Time last_stamp;
-  auto sendFrame = [&](int k) {
+  // Image k of the path, stamped `later` images on (the path again after a ~reset).
+  auto sendFrame = [&](int k, int later = 0) {
     const double t = k / 30.0;
     TrackFrame f = world.frame(t);
-    f.stamp = (start + ros::Duration(t)).toSec();
+    f.stamp = (start + ros::Duration((k + later) / 30.0)).toSec();
     const ros::Time stamp(f.stamp);  // what the tracks carry: the same nanoseconds on tf
     truth_map_from_base = ros_from_target * world.truthMapFromCamera(t) * base_from_camera.inverse();
     std::vector<geometry_msgs::TransformStamped> out;
@@ -475,6 +477,33 @@ TEST(TfTree, StaysATreeWithOdometry) {
     ASSERT_TRUE(camera.waitFresh());
     EXPECT_EQ(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
     EXPECT_NE(camera.message().find("second parent"), std::string::npos) << camera.message();
+
+    // ~reset: auto mode now sees the static parent (below_odom), but odom -> plane_map would
+    // loop through our earlier plane_map -> odom, which the tf listeners keep (they dropped
+    // the late static link): nothing is published, and the ERROR says how to get out
+    // (before, the reset chose plane_map -> odom again and hit the same conflict).
+    std_srvs::Empty reset;
+    ASSERT_TRUE(ros::service::call("/camera/plane_detector/reset", reset));
+    int below_after = 0;
+    ros::Subscriber below_sub = nh.subscribe<tf2_msgs::TFMessage>(
+        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+          for (const auto& t : m->transforms) {
+            ours_after += t.child_frame_id == "odom" && t.header.frame_id == "plane_map";
+            below_after += t.child_frame_id == "plane_map";
+          }
+        });
+    // The path again from its start (the target in view: the map starts over), stamps on.
+    for (int k = 0; k < 150; ++k) {
+      sendFrame(k, 170);
+      if (HasFatalFailure()) return;
+    }
+    spinUntil([] { return false; }, 1.0);
+    EXPECT_EQ(ours_after, 0) << "plane_map -> odom published again after the reset";
+    EXPECT_EQ(below_after, 0) << "odom -> plane_map published: a loop for the listeners";
+    ASSERT_TRUE(camera.waitFresh());
+    EXPECT_EQ(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
+    EXPECT_NE(camera.message().find("tf_mode:=below_odom"), std::string::npos)
+        << camera.message();
   }
 
   // The nodelet told to publish the camera's own frame refused, loudly.
