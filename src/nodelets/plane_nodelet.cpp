@@ -309,7 +309,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       ++dropped_info_;
       // One throttle per reason: an unknown distortion model after a zero K is named too.
       if (problems_.note("camera_info " + reasonKind(error), "camera_info rejected: " + error, 10.0))
-        NODELET_WARN("camera_info rejected: %s; image-space planes only", error.c_str());
+        NODELET_WARN("camera_info rejected: %s; %s", error.c_str(),
+                     calibration_.latest() ? "the last usable one stays in use"
+                                           : "image-space planes only");
       return;
     }
     calibration_.offer(camera);  // (its size with binning and ROI applied)
@@ -394,6 +396,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem) {
     tf_problem.clear();
     if (odom_frame_.empty()) return {};
+    tf_problem = rigidOdomFrame(tfFrame(header.frame_id));
+    if (!tf_problem.empty()) {
+      if (logNow("odometry rigid", 10.0)) NODELET_ERROR("%s: visual pose only", tf_problem.c_str());
+      return {};
+    }
     try {
       // Never wait in a callback: drain() waited (odom_wait_s) without blocking; now
       // take what tf has for this stamp or go visual.
@@ -427,6 +434,25 @@ class PlaneNodelet : public nodelet::Nodelet {
                      tf_problem.empty() ? "" : "; ", tf_problem.c_str());
       return {};
     }
+  }
+
+  // odom_frame reached from the camera by static links only (/tf_static: a URDF's mount,
+  // e.g. odom_frame:=base_link): it moves with the camera, so its "odometry" would say the
+  // camera never moves, and plane_map -> base_link would give the robot's frame a second
+  // parent. Why, or "" when odom_frame is not such a frame.
+  std::string rigidOdomFrame(const std::string& camera) const {
+    std::lock_guard<std::mutex> lock(static_mutex_);
+    std::string frame = camera;
+    for (int depth = 0; depth < 64; ++depth) {
+      const auto it = static_parents_.find(frame);
+      if (it == static_parents_.end()) return {};
+      frame = it->second;
+      if (frame == odom_frame_)
+        return "odom_frame '" + odom_frame_ + "' is rigidly attached to the camera frame '" +
+               camera + "' (static transforms only, /tf_static): it moves with the camera, so "
+               "it is no odometry; set odom_frame to the odometry's fixed frame (e.g. odom)";
+    }
+    return {};
   }
 
   // Why tf cannot link odom_frame to the camera at any time, "" when it can (then only
@@ -797,7 +823,10 @@ class PlaneNodelet : public nodelet::Nodelet {
         NODELET_WARN(
             "%.3f s without tracks: tracking lost, waiting for %s to place the camera "
             "again",
-            result.pause_s, odom_frame_.empty() ? "the map or the target" : "the odometry");
+            result.pause_s,
+            !odom_frame_.empty()                                  ? "the odometry"
+            : node_.pipeline.pose.metric_source == "camera_height" ? "the map"
+                                                                   : "the map or the target");
       if (result.state != last_state_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;

@@ -331,7 +331,10 @@ TEST(TfTree, StaysATreeWithOdometry) {
   ros::Publisher conflict_tracks = nh.advertise<Tracks>("/conflict/tracks", 20);
   ros::Publisher conflict_info =
       nh.advertise<sensor_msgs::CameraInfo>("/conflict/camera_info", 1, true);
-  Answers planes(nh, "/camera/planes"), conflict_planes(nh, "/conflict/planes");
+  ros::Publisher rigid_tracks = nh.advertise<Tracks>("/rigid/tracks", 20);
+  ros::Publisher rigid_info = nh.advertise<sensor_msgs::CameraInfo>("/rigid/camera_info", 1, true);
+  Answers planes(nh, "/camera/planes"), conflict_planes(nh, "/conflict/planes"),
+      rigid_planes(nh, "/rigid/planes");
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   tf2_ros::TransformBroadcaster broadcaster;
@@ -347,10 +350,11 @@ TEST(TfTree, StaysATreeWithOdometry) {
   urdf.sendTransform(mount);
   info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
   conflict_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
+  rigid_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
   spinUntil(
       [&] {
         return tracks.getNumSubscribers() > 0 && conflict_tracks.getNumSubscribers() > 0 &&
-               planes.sub.getNumPublishers() > 0;
+               rigid_tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0;
       },
       30.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
@@ -394,11 +398,13 @@ TEST(TfTree, StaysATreeWithOdometry) {
     // (the pipeline waits for it, odom_wait_s; it took "visual pose only" before).
     tracks.publish(toTracks(f, "camera_optical"));
     conflict_tracks.publish(toTracks(f, "camera_optical"));
+    rigid_tracks.publish(toTracks(f, "camera_optical"));
     ros::WallDuration(0.02).sleep();
     broadcaster.sendTransform(out);
     last = planes.wait(stamp);
     ASSERT_TRUE(last) << "image " << k;
     ASSERT_TRUE(conflict_planes.wait(stamp)) << "image " << k;
+    ASSERT_TRUE(rigid_planes.wait(stamp)) << "image " << k;
     last_stamp = stamp;
   };
   int with_odometry = 0, without_after_start = 0;  // images once the start placed the map
@@ -428,6 +434,16 @@ TEST(TfTree, StaysATreeWithOdometry) {
   ASSERT_EQ(ours.size(), 1u);
   EXPECT_EQ(*ours.begin(), localiser ? "odom -> plane_map" : "plane_map -> odom");
   EXPECT_EQ(recorder.edges_by_publisher.count("/conflict/manager"), 0u);
+  EXPECT_EQ(recorder.edges_by_publisher.count("/rigid/manager"), 0u);
+  {
+    // odom_frame:=base_link: no odometry taken from a frame rigid with the camera.
+    DiagnosticsProbe rigid(nh, "rigid/plane_detector: planes");
+    ASSERT_TRUE(rigid.waitFresh());
+    EXPECT_GE(rigid.level(), diagnostic_msgs::DiagnosticStatus::WARN) << rigid.message();
+    EXPECT_NE(rigid.message().find("rigidly attached"), std::string::npos) << rigid.message();
+    const PlaneArrayConstPtr r = rigid_planes.by_stamp.rbegin()->second;
+    EXPECT_NE(r->status.rfind("tracking (odometry)", 0), 0u) << r->status;
+  }
   // plane_map -> base_link through tf, against the truth.
   ASSERT_TRUE(buffer.canTransform("plane_map", "base_link", last_stamp, ros::Duration(2.0)));
   const Pose through_tf = fromTransformMsg(
