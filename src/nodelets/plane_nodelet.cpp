@@ -441,12 +441,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   // camera never moves, and plane_map -> base_link would give the robot's frame a second
   // parent. Why, or "" when odom_frame is not such a frame.
   std::string rigidOdomFrame(const std::string& camera) const {
-    std::lock_guard<std::mutex> lock(static_mutex_);
     std::string frame = camera;
     for (int depth = 0; depth < 64; ++depth) {
-      const auto it = static_parents_.find(frame);
-      if (it == static_parents_.end()) return {};
-      frame = it->second;
+      const std::optional<std::string> parent = staticParent(frame);
+      if (!parent) return {};
+      frame = *parent;
       if (frame == odom_frame_)
         return "odom_frame '" + odom_frame_ + "' is rigidly attached to the camera frame '" +
                camera + "' (static transforms only, /tf_static): it moves with the camera, so "
@@ -489,15 +488,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   }
 
   std::string tfConflict(const std::string& parent, const std::string& child) const {
-    {
-      // We never publish static links: any static link to our child is another's.
-      std::lock_guard<std::mutex> lock(static_mutex_);
-      const auto it = static_parents_.find(child);
-      if (it != static_parents_.end())
-        return "frame '" + child + "' has the static parent '" + it->second +
-               "' on tf_static: publishing " + parent + " -> " + child +
-               " would give it a second parent";
-    }
+    // We never publish static links: any static link to our child is another's.
+    if (const std::optional<std::string> other = staticParent(child))
+      return "frame '" + child + "' has the static parent '" + *other +
+             "' on tf_static: publishing " + parent + " -> " + child +
+             " would give it a second parent";
     std::string existing;
     if (tf_buffer_->_getParent(child, ros::Time(0), existing)) {
       if (existing != parent)
@@ -529,12 +524,18 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   // ", and dropped the static parent 'p' of 'frame' sent after it" when /tf_static has one.
   std::string staticParentNote(const std::string& frame) const {
+    const std::optional<std::string> parent = staticParent(frame);
+    return !parent ? std::string()
+                   : ", and dropped the static parent '" + *parent + "' of '" + frame +
+                         "' sent after it (TF_OLD_DATA)";
+  }
+
+  // frame's parent on /tf_static, as heard (tf2 may have dropped it: see onTfStatic).
+  std::optional<std::string> staticParent(const std::string& frame) const {
     std::lock_guard<std::mutex> lock(static_mutex_);
     const auto it = static_parents_.find(frame);
-    return it == static_parents_.end()
-               ? std::string()
-               : ", and dropped the static parent '" + it->second + "' of '" + frame +
-                     "' sent after it (TF_OLD_DATA)";
+    if (it == static_parents_.end()) return {};
+    return it->second;
   }
 
   // The one transform this nodelet publishes for this image, if any (mutex_ held).
@@ -551,17 +552,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (resolved_tf_mode_.empty()) {
         // A static parent first: tf2 drops one sent after a dynamic link to the same frame
         // (ours, before a ~reset), so only /tf_static shows it (as to tfConflict).
-        std::string odom_parent;
-        bool has_parent = false;
-        {
-          std::lock_guard<std::mutex> lock(static_mutex_);
-          const auto it = static_parents_.find(odom_frame_);
-          if (it != static_parents_.end()) {
-            odom_parent = it->second;
-            has_parent = true;
-          }
-        }
-        if (!has_parent) has_parent = tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
+        std::string odom_parent = staticParent(odom_frame_).value_or("");
+        const bool has_parent = !odom_parent.empty() ||
+                                tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
         resolved_tf_mode_ = tf_mode_ != "auto"                             ? tf_mode_
                             : has_parent && odom_parent != map_frame_ ? "below_odom"
                                                                            : "above_odom";
