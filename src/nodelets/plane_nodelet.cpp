@@ -171,11 +171,12 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
     }
     // tf2 keeps one cache per frame: a static parent that comes after our own dynamic
-    // link to the same child hides behind it there. Static links are few and latched:
-    // their parents are kept here for the tf check.
-    if (publish_tf_)
+    // link to the same child hides behind it there. Static links are latched, one
+    // message per publisher on connecting (tf2_ros's own queue: 100): their parents are
+    // kept here for the tf check and for odom_frame's (rigidOdomFrame).
+    if (publish_tf_ || !odom_frame_.empty())
       static_sub_ = nh.subscribe<tf2_msgs::TFMessage>(
-          "/tf_static", 10, guard_.message("tf_static", this, &PlaneNodelet::onTfStatic));
+          "/tf_static", 100, guard_.message("tf_static", this, &PlaneNodelet::onTfStatic));
     node_ = node;
     startReconfigure(pnh);
     reset_srv_ = pnh.advertiseService("reset", &PlaneNodelet::onReset, this);
@@ -441,6 +442,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   // camera never moves, and plane_map -> base_link would give the robot's frame a second
   // parent. Why, or "" when odom_frame is not such a frame.
   std::string rigidOdomFrame(const std::string& camera) const {
+    if (camera == odom_frame_)
+      return "odom_frame '" + odom_frame_ + "' is the camera frame itself: it is no odometry; " +
+             "set odom_frame to the odometry's fixed frame (e.g. odom)";
     std::string frame = camera;
     for (int depth = 0; depth < 64; ++depth) {
       const std::optional<std::string> parent = staticParent(frame);
@@ -788,6 +792,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       // (Tracks of before a jump back of the clock say nothing of the odometry now.)
       if (!before_jump) {
         odom_tf_problem_ = odom_tf_problem;
+        odom_rigid_ = !odom_frame_.empty() && !rigidOdomFrame(tfFrame(msg.header.frame_id)).empty();
         odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
       }
       if (result.was_reset) {
@@ -906,8 +911,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       problems.add(
           DiagnosticStatus::WARN, "tracking",
           status_.rfind("lost", 0) == 0 ? "tracking " + status_ : "tracking lost: " + status_);
-    if (!odom_tf_problem_.empty())
-      problems.add(DiagnosticStatus::WARN, "odometry", "no odometry: " + odom_tf_problem_);
+    if (!odom_tf_problem_.empty())  // (a rigid odom_frame is a configuration error)
+      problems.add(odom_rigid_ ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, "odometry",
+                   "no odometry: " + odom_tf_problem_);
     else if (odometry_stopped_)
       problems.add(DiagnosticStatus::WARN, "odometry",
                    "odometry (" + odom_frame_ + ") stopped, or more than odom_wait_s (" +
@@ -1005,6 +1011,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   long info_frame_mismatch_ = 0;        // tracks whose camera_info names another frame
   long backwards_resets_ = 0;           // map resets because time went backwards
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
+  bool odom_rigid_ = false;             // ...because odom_frame is rigid with the camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;

@@ -354,7 +354,9 @@ TEST(TfTree, StaysATreeWithOdometry) {
   spinUntil(
       [&] {
         return tracks.getNumSubscribers() > 0 && conflict_tracks.getNumSubscribers() > 0 &&
-               rigid_tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0;
+               rigid_tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0 &&
+               conflict_planes.sub.getNumPublishers() > 0 &&
+               rigid_planes.sub.getNumPublishers() > 0;
       },
       30.0);
   ASSERT_GT(tracks.getNumSubscribers(), 0u);
@@ -439,8 +441,9 @@ TEST(TfTree, StaysATreeWithOdometry) {
     // odom_frame:=base_link: no odometry taken from a frame rigid with the camera.
     DiagnosticsProbe rigid(nh, "rigid/plane_detector: planes");
     ASSERT_TRUE(rigid.waitFresh());
-    EXPECT_GE(rigid.level(), diagnostic_msgs::DiagnosticStatus::WARN) << rigid.message();
-    EXPECT_NE(rigid.message().find("rigidly attached"), std::string::npos) << rigid.message();
+    EXPECT_EQ(rigid.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << rigid.message();
+    EXPECT_NE(rigid.value("problem: odometry").find("rigidly attached"), std::string::npos)
+        << rigid.value("problem: odometry");
     const PlaneArrayConstPtr r = rigid_planes.by_stamp.rbegin()->second;
     EXPECT_NE(r->status.rfind("tracking (odometry)", 0), 0u) << r->status;
   }
