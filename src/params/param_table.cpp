@@ -393,7 +393,8 @@ const ParamTable<PipelineParams>& pipelineParamTable() {
         {"min_keyframe_shared", field(&P::min_keyframe_shared), 0, 1, "",
          "share of this image's tracks a reference must still hold"},
         {"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
-         "a longer pause between tracks messages (and over 3 of their periods) is a tracking loss"},
+         "a longer pause between tracks messages (and over 3 of their periods; 3 x this "
+         "before the first 3) is a tracking loss"},
         {"motion_plane_images", field(&P::motion_plane_images), 0, 1000, "images",
          "an image plane with too few landmarks: a plane from its tracks' motion and the "
          "known poses, mapped after this many fits once its normal is known to "
@@ -424,8 +425,8 @@ const ParamTable<TrackerNodeParams>& trackerNodeParamTable() {
                  "the images are rectified: camera_info's P, no distortion, for the start-up "
                  "target (also when the image topic is image_rect*)"});
     t.push_back({"max_gap_s", field(&P::max_gap_s), 1e-3, 1e6, "s",
-                 "a longer pause between images (and over 3 of their periods) is a tracking loss "
-                 "(start over)"});
+                 "a longer pause between images (and over 3 of their periods; 3 x this before "
+                 "the first 3) is a tracking loss (start over)"});
     t.push_back({"target_timeout_s", field(&P::target_timeout_s), 0.1, 1e6, "s",
                  "diagnostics WARN (with the reason) when images arrive this long without a "
                  "start-up target"});

@@ -28,7 +28,9 @@ bool GapCounter::isPause(int64_t interval_ns, double max_gap_s) const {
   const double seconds = static_cast<double>(interval_ns) * 1e-9;
   if (seconds <= max_gap_s) return false;
   const int64_t period = periodNs();
-  return period <= 0 || static_cast<double>(interval_ns) > kPausePeriods * period;
+  // (A 1 Hz bag's first second was a "tracking lost" WARN at every start.)
+  if (period <= 0) return seconds > kPausePeriods * max_gap_s;
+  return static_cast<double>(interval_ns) > kPausePeriods * period;
 }
 
 void GapCounter::addPause(int64_t interval_ns) {

@@ -240,8 +240,9 @@ TEST_F(TrackerNodeletTest, DuplicateStampsGapsAndEmptyFrameIds) {
   received_.clear();
   auto again = makeImage(view({0.5, 0}), "mono8", stamp_);
   EXPECT_FALSE(send(again, 1.0));
-  // After a 2 s pause: tracking starts over (every point new).
-  auto after_gap = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 2.0));
+  // After a 4 s pause: tracking starts over (every point new; over 3 x max_gap_s, a pause
+  // also while the stream's period is not known yet).
+  auto after_gap = send(makeImage(view({0.5, 0}), "mono8", stamp_ += 4.0));
   ASSERT_TRUE(after_gap);
   ASSERT_GE(after_gap->flags.size(), 45u);
   for (auto f : after_gap->flags) EXPECT_TRUE(f & Tracks::FLAG_NEW);

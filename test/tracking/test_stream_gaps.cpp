@@ -37,8 +37,10 @@ TEST(GapCounter, PauseFollowsTheStreamsOwnPeriod) {
   EXPECT_FALSE(fast.isPause(kSecond / 2, 1.0));  // under max_gap_s: never a pause
   EXPECT_TRUE(fast.isPause(kSecond + kSecond / 10, 1.0));
 
-  GapCounter slow;  // before its period is known, max_gap_s alone decides
-  EXPECT_TRUE(slow.isPause(kSecond + kSecond / 50, 1.0));
+  GapCounter slow;  // before its period is known: over 3 x max_gap_s
+  EXPECT_FALSE(slow.isPause(kSecond + kSecond / 50, 1.0));  // a 1 Hz bag's first second
+  EXPECT_FALSE(slow.isPause(3 * kSecond, 1.0));
+  EXPECT_TRUE(slow.isPause(3 * kSecond + kSecond / 10, 1.0));
   for (int k = 0; k < 3; ++k) slow.addPause(kSecond + k * kSecond / 50);
   EXPECT_FALSE(slow.isPause(kSecond + kSecond / 20, 1.0));
   EXPECT_FALSE(slow.isPause(3 * kSecond, 1.0));

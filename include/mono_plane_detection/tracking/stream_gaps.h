@@ -35,7 +35,8 @@ class GapCounter {
   // three); 0 before three intervals.
   int64_t periodNs() const;
   // An interval after which tracking starts over: longer than max_gap_s and, once the
-  // period is known, than kPausePeriods periods.
+  // period is known, than kPausePeriods periods; before it is known (the stream's first
+  // intervals are all the rhythm there is), longer than kPausePeriods x max_gap_s.
   bool isPause(int64_t interval_ns, double max_gap_s) const;
 
  private:
