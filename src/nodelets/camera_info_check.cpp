@@ -177,6 +177,11 @@ std::string cameraModelName(const CalibrationHolder& calibration, const cv::Size
                                    : "raw (K, D)";
 }
 
+std::string rectifiedBy(bool rectified_parameter, const std::string& topic) {
+  if (rectified_parameter) return "parameter rectified";
+  return isRectifiedTopic(topic) ? topic : std::string();
+}
+
 bool isRectifiedTopic(const std::string& topic) {
   const std::string base = topic.substr(topic.find_last_of('/') + 1);
   return base.rfind("image_rect", 0) == 0;

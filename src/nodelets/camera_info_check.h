@@ -86,6 +86,9 @@ std::string cameraModelName(const CalibrationHolder& calibration, const cv::Size
 
 // A rectified stream by its topic's name: image_proc calls it image_rect (or image_rect_color).
 bool isRectifiedTopic(const std::string& resolved_image_topic);
+// Why a nodelet takes its images as rectified (P, no distortion), "" when raw (K, D): the
+// parameter `rectified`, or the topic's name (isRectifiedTopic). Both nodelets apply it.
+std::string rectifiedBy(bool rectified_parameter, const std::string& resolved_image_topic);
 
 // Equidistant cameras: every pixel moved to where the pinhole camera K sees the same ray
 // (cv::fisheye::undistortPoints); points that land outside the image are dropped. No-op

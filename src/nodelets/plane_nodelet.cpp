@@ -138,11 +138,11 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_mode_ = "auto";
     }
     // image_proc's rectified stream, or said so: P without distortion (image_geometry).
-    const std::string image_topic = nh.resolveName("image");
-    rectified_ = node.rectified || isRectifiedTopic(image_topic);
+    const std::string rectified_by = rectifiedBy(node.rectified, nh.resolveName("image"));
+    rectified_ = !rectified_by.empty();
     if (rectified_)
       NODELET_INFO("rectified images (%s): camera_info's P is used, without distortion",
-                   node.rectified ? "parameter rectified" : image_topic.c_str());
+                   rectified_by.c_str());
 
     // Tracks held by an odometry wait are processed in one burst when it ends (one
     // callback of this nodelet's single-threaded queue) while new ones queue in the
@@ -394,11 +394,15 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   // tf_problem: why tf links no odometry to these tracks' camera at all ("" when it does,
   // or when only this stamp is missing: the odometry stopped or is late).
-  std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem) {
+  // rigid: tf_problem is odom_frame rigid with the camera (a configuration error).
+  std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem,
+                               bool& rigid) {
     tf_problem.clear();
+    rigid = false;
     if (odom_frame_.empty()) return {};
     tf_problem = rigidOdomFrame(tfFrame(header.frame_id));
-    if (!tf_problem.empty()) {
+    rigid = !tf_problem.empty();
+    if (rigid) {
       if (logNow("odometry rigid", 10.0)) NODELET_ERROR("%s: visual pose only", tf_problem.c_str());
       return {};
     }
@@ -719,8 +723,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     const ros::WallTime started = ros::WallTime::now();
     const bool before_jump = fromBeforeClockJump(msg.header.stamp);
     std::string odom_tf_problem;
+    bool odom_rigid = false;
     const std::optional<Pose> odom =
-        before_jump ? std::nullopt : odometry(msg.header, odom_tf_problem);
+        before_jump ? std::nullopt : odometry(msg.header, odom_tf_problem, odom_rigid);
     PlaneArrayPtr planes, image_planes;
     geometry_msgs::PoseStampedPtr pose;
     visualization_msgs::MarkerArrayPtr markers;
@@ -792,7 +797,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       // (Tracks of before a jump back of the clock say nothing of the odometry now.)
       if (!before_jump) {
         odom_tf_problem_ = odom_tf_problem;
-        odom_rigid_ = !odom_frame_.empty() && !rigidOdomFrame(tfFrame(msg.header.frame_id)).empty();
+        odom_rigid_ = odom_rigid;
         odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
       }
       if (result.was_reset) {

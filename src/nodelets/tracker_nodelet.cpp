@@ -57,11 +57,11 @@ class TrackerNodelet : public nodelet::Nodelet {
     // the plane nodelet reads them; else the raw image's K and D (the target is searched
     // undistorted).
     image_topic_ = nh.resolveName("image");
-    const bool rectified = params.rectified || isRectifiedTopic(image_topic_);
-    front_.setRectified(rectified);
-    if (rectified)
+    const std::string rectified_by = rectifiedBy(params.rectified, image_topic_);
+    front_.setRectified(!rectified_by.empty());
+    if (!rectified_by.empty())
       NODELET_INFO("rectified images (%s): camera_info's P is used, without distortion",
-                   params.rectified ? "parameter rectified" : image_topic_.c_str());
+                   rectified_by.c_str());
 
     diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose, guard_,
                        params.expected_min_rate_hz, params.expected_max_rate_hz);

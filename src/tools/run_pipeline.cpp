@@ -292,6 +292,11 @@ int main(int argc, char** argv) {
     for (const MapPlane& p : pipeline.map().planes())
       (p.confirmed(pipeline.map().params()) ? confirmed : tentative).push_back(p);
     std::vector<TruthPlane> judged = truth;
+    const auto truthPlane = [&](int id) -> const TruthPlane* {  // null: no such id
+      for (const TruthPlane& t : judged)
+        if (t.id == id) return &t;
+      return nullptr;
+    };
     // Distances from the first camera position (the target frame's origin is 20 m up).
     const cv::Vec3d shift = truth_from_map ? cv::Vec3d(-truth_map.front()) : cv::Vec3d(0, 0, 0);
     // A map point in the frame the planes are judged in.
@@ -316,9 +321,9 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < confirmed.size(); ++i) {
       const MapPlane& p = confirmed[i];
       const PlaneMatch& m = eval.matches[i];
-      double relative = 0;
-      for (const TruthPlane& t : judged)
-        if (t.id == m.truth_id && t.range_m > 0) relative = m.distance_error_m / t.range_m;
+      const TruthPlane* matched = truthPlane(m.truth_id);
+      const double relative =
+          matched && matched->range_m > 0 ? m.distance_error_m / matched->range_m : 0.0;
       std::printf(
           "  plane %d: n=(%.3f %.3f %.3f) d=%.3f m, %zu points, %d obs -> %s "
           "(normal %.2f deg, distance %.3f m = %.1f %%)\n",
@@ -347,9 +352,7 @@ int main(int argc, char** argv) {
       // The distance error where the plane is (its points projected onto it), not at the
       // map's origin, where a small normal error grows with the lever.
       double at_points = 0;
-      const auto matched = std::find_if(judged.begin(), judged.end(),
-                                        [&](const TruthPlane& t) { return t.id == m.truth_id; });
-      if (matched != judged.end() && !p.points.empty()) {
+      if (matched && !p.points.empty()) {
         for (const auto& [id, entry] : p.points) {
           cv::Vec3d y = judgedFrame(entry.first);
           y -= (p.normal.dot(y) - p.distance) * p.normal;
@@ -383,10 +386,8 @@ int main(int argc, char** argv) {
     for (const PlaneMatch& m : eval.matches) false_planes += m.truth_id < 0;
     std::printf("false planes %d\n", false_planes);
     for (int id : eval.missed) {
-      const auto missed = std::find_if(judged.begin(), judged.end(),
-                                       [&](const TruthPlane& t) { return t.id == id; });
-      std::printf("  missed: true plane %d (%s)\n", id,
-                  missed != judged.end() ? missed->name.c_str() : "?");
+      const TruthPlane* missed = truthPlane(id);
+      std::printf("  missed: true plane %d (%s)\n", id, missed ? missed->name.c_str() : "?");
     }
     std::printf("missed %zu, split %zu, worst normal %.2f deg, worst distance %.3f m\n",
                 eval.missed.size(), eval.split.size(), eval.worst_normal_error_deg,

@@ -111,6 +111,10 @@ TEST(CameraInfoCheck, RectifiedStreamsUsePWithoutDistortion) {
   EXPECT_TRUE(isRectifiedTopic("/rear/image_rect_color"));
   EXPECT_FALSE(isRectifiedTopic("/camera/image_raw"));
   EXPECT_FALSE(isRectifiedTopic("/image_rect_cam/image_raw"));
+  // Both nodelets' rule: the parameter, or the topic's name.
+  EXPECT_EQ(rectifiedBy(false, "/camera/image_raw"), "");
+  EXPECT_EQ(rectifiedBy(false, "/camera/image_rect"), "/camera/image_rect");
+  EXPECT_EQ(rectifiedBy(true, "/camera/image_raw"), "parameter rectified");
 }
 
 // What each nodelet's diagnostics say it uses ("camera model"): none before a camera_info,
