@@ -497,10 +497,15 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   std::string tfConflict(const std::string& parent, const std::string& child) const {
     // We never publish static links: any static link to our child is another's.
-    if (const std::optional<std::string> other = staticParent(child))
+    if (const std::optional<std::string> other = staticParent(child)) {
+      if (*other == parent)
+        return "'" + parent + " -> " + child +
+               "' is already on tf_static from another broadcaster: publishing it too would "
+               "give two sources of one link";
       return "frame '" + child + "' has the static parent '" + *other +
              "' on tf_static: publishing " + parent + " -> " + child +
              " would give it a second parent";
+    }
     std::string existing;
     if (tf_buffer_->_getParent(child, ros::Time(0), existing)) {
       if (existing != parent)

@@ -333,8 +333,11 @@ TEST(TfTree, StaysATreeWithOdometry) {
       nh.advertise<sensor_msgs::CameraInfo>("/conflict/camera_info", 1, true);
   ros::Publisher rigid_tracks = nh.advertise<Tracks>("/rigid/tracks", 20);
   ros::Publisher rigid_info = nh.advertise<sensor_msgs::CameraInfo>("/rigid/camera_info", 1, true);
+  ros::Publisher duplicate_tracks = nh.advertise<Tracks>("/duplicate/tracks", 20);
+  ros::Publisher duplicate_info =
+      nh.advertise<sensor_msgs::CameraInfo>("/duplicate/camera_info", 1, true);
   Answers planes(nh, "/camera/planes"), conflict_planes(nh, "/conflict/planes"),
-      rigid_planes(nh, "/rigid/planes");
+      rigid_planes(nh, "/rigid/planes"), duplicate_planes(nh, "/duplicate/planes");
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   tf2_ros::TransformBroadcaster broadcaster;
@@ -351,10 +354,12 @@ TEST(TfTree, StaysATreeWithOdometry) {
   info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
   conflict_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
   rigid_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
+  duplicate_info.publish(cameraInfo(world.camera, world.camera, "camera_optical"));
   spinUntil(
       [&] {
         return tracks.getNumSubscribers() > 0 && conflict_tracks.getNumSubscribers() > 0 &&
-               rigid_tracks.getNumSubscribers() > 0 && planes.sub.getNumPublishers() > 0 &&
+               rigid_tracks.getNumSubscribers() > 0 && duplicate_tracks.getNumSubscribers() > 0 &&
+               planes.sub.getNumPublishers() > 0 && duplicate_planes.sub.getNumPublishers() > 0 &&
                conflict_planes.sub.getNumPublishers() > 0 &&
                rigid_planes.sub.getNumPublishers() > 0;
       },
@@ -401,12 +406,14 @@ TEST(TfTree, StaysATreeWithOdometry) {
     tracks.publish(toTracks(f, "camera_optical"));
     conflict_tracks.publish(toTracks(f, "camera_optical"));
     rigid_tracks.publish(toTracks(f, "camera_optical"));
+    duplicate_tracks.publish(toTracks(f, "camera_optical"));
     ros::WallDuration(0.02).sleep();
     broadcaster.sendTransform(out);
     last = planes.wait(stamp);
     ASSERT_TRUE(last) << "image " << k;
     ASSERT_TRUE(conflict_planes.wait(stamp)) << "image " << k;
     ASSERT_TRUE(rigid_planes.wait(stamp)) << "image " << k;
+    ASSERT_TRUE(duplicate_planes.wait(stamp)) << "image " << k;
     last_stamp = stamp;
   };
   int with_odometry = 0, without_after_start = 0;  // images once the start placed the map
@@ -437,6 +444,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
   EXPECT_EQ(*ours.begin(), localiser ? "odom -> plane_map" : "plane_map -> odom");
   EXPECT_EQ(recorder.edges_by_publisher.count("/conflict/manager"), 0u);
   EXPECT_EQ(recorder.edges_by_publisher.count("/rigid/manager"), 0u);
+  EXPECT_EQ(recorder.edges_by_publisher.count("/duplicate/manager"), 0u);
   {
     // odom_frame:=base_link: no odometry taken from a frame rigid with the camera.
     DiagnosticsProbe rigid(nh, "rigid/plane_detector: planes");
@@ -530,6 +538,14 @@ TEST(TfTree, StaysATreeWithOdometry) {
   ASSERT_TRUE(conflict.waitFresh());
   EXPECT_EQ(conflict.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << conflict.message();
   EXPECT_NE(conflict.message().find("second parent"), std::string::npos) << conflict.message();
+
+  // The nodelet told to publish a link the URDF already sends: refused, and said so.
+  DiagnosticsProbe duplicate(nh, "duplicate/plane_detector: planes");
+  ASSERT_TRUE(duplicate.waitFresh());
+  EXPECT_EQ(duplicate.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << duplicate.message();
+  EXPECT_NE(duplicate.message().find("'base_link -> camera_optical' is already on tf_static"),
+            std::string::npos)
+      << duplicate.message();
 }
 
 }  // namespace
