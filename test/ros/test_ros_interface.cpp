@@ -322,8 +322,9 @@ struct TfRecorder {
 
 TEST(TfTree, StaysATreeWithOdometry) {
   ros::NodeHandle nh, pnh("~");
-  bool localiser = false;
+  bool localiser = false, late_localiser = false;
   pnh.param("localiser", localiser, false);
+  pnh.param("late_localiser", late_localiser, false);
   TfRecorder recorder(nh);
   SyntheticTracks world("wheeled");
   ros::Publisher tracks = nh.advertise<Tracks>("/camera/tracks", 20);
@@ -379,6 +380,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
   PlaneArrayConstPtr last;
   Pose truth_map_from_base;
   ros::Time last_stamp;
+  bool amcl_on = localiser;  // another localiser's map -> odom sent with the odometry
   // Image k of the path, stamped `later` images on (the path again after a ~reset).
   auto sendFrame = [&](int k, int later = 0) {
     const double t = k / 30.0;
@@ -393,7 +395,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
     odom.child_frame_id = "base_link";
     odom.transform = toTransformMsg(odom_from_rosmap * truth_map_from_base);
     out.push_back(odom);
-    if (localiser) {
+    if (amcl_on) {
       geometry_msgs::TransformStamped amcl;
       amcl.header.stamp = stamp;
       amcl.header.frame_id = "map";
@@ -470,7 +472,61 @@ TEST(TfTree, StaysATreeWithOdometry) {
     EXPECT_EQ(parent, "map");  // the localiser's link is untouched
   }
 
-  if (!localiser) {
+  if (late_localiser) {
+    // Another localiser (AMCL) that starts after the pipeline's plane_map -> odom: its
+    // dynamic map -> odom gives odom a second parent. The nodelet must stop publishing
+    // with an ERROR; after ~reset, tf_mode auto sees the localiser's parent (newer stamps
+    // than ours) and attaches odom -> plane_map below it.
+    amcl_on = true;
+    int ours_late = 0, heard = 0;  // ours after the localiser's second image
+    const ros::Time localiser_start = start + ros::Duration(151 / 30.0);
+    ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>(
+        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+          for (const auto& t : m->transforms) {
+            ++heard;
+            ours_late += t.child_frame_id == "odom" && t.header.frame_id == "plane_map" &&
+                         t.header.stamp > localiser_start;
+          }
+        });
+    for (int k = 150; k < 170; ++k) {
+      sendFrame(k);
+      if (HasFatalFailure()) return;
+    }
+    spinUntil([] { return false; }, 1.0);
+    EXPECT_GT(heard, 0) << "no /tf heard: the check below would say nothing";
+    EXPECT_EQ(ours_late, 0) << "plane_map -> odom still published beside the localiser's map -> odom";
+    DiagnosticsProbe camera(nh, "camera/plane_detector: planes");
+    ASSERT_TRUE(camera.waitFresh());
+    EXPECT_EQ(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
+    EXPECT_NE(camera.message().find("second parent"), std::string::npos) << camera.message();
+
+    std_srvs::Empty reset;
+    ASSERT_TRUE(ros::service::call("/camera/plane_detector/reset", reset));
+    int above_after = 0, below_after = 0;
+    ros::Subscriber after_sub = nh.subscribe<tf2_msgs::TFMessage>(
+        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+          for (const auto& t : m->transforms) {
+            above_after += t.child_frame_id == "odom" && t.header.frame_id == "plane_map";
+            below_after += t.child_frame_id == "plane_map" && t.header.frame_id == "odom";
+          }
+        });
+    for (int k = 0; k < 150; ++k) {  // the path again (the map starts over), stamps on
+      sendFrame(k, 170);
+      if (HasFatalFailure()) return;
+    }
+    spinUntil([] { return false; }, 1.0);
+    EXPECT_EQ(above_after, 0) << "plane_map -> odom published again after the reset";
+    EXPECT_GT(below_after, 60) << "odom -> plane_map not published below the localiser";
+    ASSERT_TRUE(camera.waitFresh());
+    EXPECT_NE(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
+    // The listeners see one tree: the localiser's map above odom, the planes' map below it.
+    std::string parent;
+    ASSERT_TRUE(buffer._getParent("odom", ros::Time(0), parent));
+    EXPECT_EQ(parent, "map");
+    ASSERT_TRUE(buffer._getParent("plane_map", ros::Time(0), parent));
+    EXPECT_EQ(parent, "odom");
+    EXPECT_TRUE(buffer.canTransform("map", "plane_map", ros::Time(0)));
+  } else if (!localiser) {
     // A static map -> odom that comes after the pipeline's plane_map -> odom (a
     // static_transform_publisher started later). tf2 hides a late static parent behind
     // the dynamic link to the same frame; odom got two parents, silently (hostile try).
