@@ -120,7 +120,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     guard_.setLogger(getName());
     PlaneNodeParams node;
-    readParams(pnh, planeNodeParamTable(), node, getName());
+    start_errors_ = readParams(pnh, planeNodeParamTable(), node, getName());
     params_ = node.pipeline;
     pipeline_ = std::make_unique<PlanePipeline>(params_);
     map_frame_ = node.map_frame;
@@ -243,6 +243,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
     const std::vector<std::string> errors = validate(node);
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
+    reconfigure_errors_ = errors;
     if (!errors.empty()) writeBack(node, config);
     node_ = node;
     params_ = node.pipeline;
@@ -908,6 +909,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     StatusProblems problems;
     if (!tf_conflict_.empty())
       problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
+    // A metric source that cannot give metres is an error until it is set.
+    const std::string blocked = metricSourceProblem(node_);
+    if (!blocked.empty()) problems.add(DiagnosticStatus::ERROR, "configuration", blocked);
     if (!target_mismatch_.empty())
       problems.add(DiagnosticStatus::ERROR, "start-up target",
                    "start-up target: " + target_mismatch_);
@@ -942,6 +946,12 @@ class PlaneNodelet : public nodelet::Nodelet {
                               "with camera_height_m)"
                         : "no metric start (" + status_ + ") for " +
                               std::to_string(static_cast<long>(waited_s)) + " s"));
+    // Other refused values were replaced by their defaults: after the present problems.
+    if (blocked.empty() && (!start_errors_.empty() || !reconfigure_errors_.empty())) {
+      std::vector<std::string> all = start_errors_;
+      for (const std::string& e : reconfigure_errors_) all.push_back("reconfigure: " + e);
+      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(all));
+    }
     if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
     for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
       problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
@@ -978,6 +988,8 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   CallbackGuard guard_;  // first member: the last destroyed
   PlaneNodeParams node_;  // as read, then as reconfigured
+  std::vector<std::string> start_errors_;        // parameters refused at start
+  std::vector<std::string> reconfigure_errors_;  // refused by the last reconfigure
   PipelineParams params_;
   std::unique_ptr<PlanePipeline> pipeline_;
   std::string map_frame_, odom_frame_, camera_frame_, transport_, tf_mode_;

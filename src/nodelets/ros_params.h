@@ -1,20 +1,23 @@
 // Reads a parameter table (param_table.h) from a private node handle: one loop for every
 // parameter, the ROS name being the table's name. A value of the wrong type or out of
 // range is named in an ERROR and the default is used; an old flat name still works, with
-// a warning naming the new one.
+// a warning naming the new one. Returns the errors (for the nodelet's diagnostics).
 #pragma once
 
 #include <ros/ros.h>
 
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "mono_plane_detection/params/param_table.h"
 
 namespace mono_plane_detection {
 
 template <class P>
-void readParams(const ros::NodeHandle& pnh, const ParamTable<P>& table, P& params,
-                const std::string& logger) {
+std::vector<std::string> readParams(const ros::NodeHandle& pnh, const ParamTable<P>& table,
+                                    P& params, const std::string& logger) {
+  std::vector<std::string> errors;
   for (const ParamSpec<P>& spec : table) {
     std::string key = spec.name;
     if (!pnh.hasParam(key)) {
@@ -31,22 +34,22 @@ void readParams(const ros::NodeHandle& pnh, const ParamTable<P>& table, P& param
                                           double, T>;
           Read read{};
           if (!pnh.getParam(key, read)) {
-            ROS_ERROR_STREAM_NAMED(logger, "parameter " << key << " has the wrong type (expected "
-                                                        << (std::is_same_v<T, bool> ? "a boolean"
-                                                            : std::is_same_v<T, std::string>
-                                                                ? "a string"
-                                                            : std::is_same_v<T, double> ? "a number"
-                                                                                        : "an integer")
-                                                        << "); using "
-                                                        << toString(ParamField(value)));
+            errors.push_back(key + " has the wrong type (expected " +
+                             (std::is_same_v<T, bool>          ? "a boolean"
+                              : std::is_same_v<T, std::string> ? "a string"
+                              : std::is_same_v<T, double>      ? "a number"
+                                                               : "an integer") +
+                             "); using " + toString(ParamField(value)));
+            ROS_ERROR_STREAM_NAMED(logger, "parameter " << errors.back());
             return;
           }
           if constexpr (std::is_same_v<Read, double> && !std::is_same_v<T, double>) {
             if (!(read >= spec.min && read <= spec.max) || read != std::floor(read)) {
-              ROS_ERROR_STREAM_NAMED(logger, "parameter " << key << " = " << read
-                                                          << " is not an integer in ["
-                                                          << spec.min << ", " << spec.max
-                                                          << "]; using " << *value);
+              std::ostringstream why;
+              why << key << " = " << read << " is not an integer in [" << spec.min << ", "
+                  << spec.max << "]; using " << *value;
+              errors.push_back(why.str());
+              ROS_ERROR_STREAM_NAMED(logger, "parameter " << errors.back());
               return;
             }
           }
@@ -54,8 +57,21 @@ void readParams(const ros::NodeHandle& pnh, const ParamTable<P>& table, P& param
         },
         spec.field(params));
   }
-  for (const std::string& error : validate(params))
+  for (const std::string& error : validate(params)) {
     ROS_ERROR_STREAM_NAMED(logger, "parameter " << error);
+    errors.push_back(error);
+  }
+  return errors;
+}
+
+// For diagnostics: "parameter refused, default used: <first>" (+ how many more).
+inline std::string refusedParamsText(const std::vector<std::string>& errors) {
+  if (errors.empty()) return {};
+  std::string text = (errors.size() == 1 ? std::string("parameter refused, default used: ")
+                                         : std::to_string(errors.size()) +
+                                               " parameters refused, defaults used (see the log): ") +
+                     errors.front();
+  return text;
 }
 
 }  // namespace mono_plane_detection

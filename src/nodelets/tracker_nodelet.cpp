@@ -51,7 +51,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     ros::NodeHandle& pnh = getPrivateNodeHandle();
     guard_.setLogger(getName());
     TrackerNodeParams params;
-    readParams(pnh, trackerNodeParamTable(), params, getName());
+    config_errors_ = readParams(pnh, trackerNodeParamTable(), params, getName());
     front_ = TrackerFrontEnd(params);
     // Rectified images (said so, or image_proc's image_rect*): P without distortion, as
     // the plane nodelet reads them; else the raw image's K and D (the target is searched
@@ -245,6 +245,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (no_target)
       problems.add(DiagnosticStatus::WARN, "start-up target",
                    "no start-up target: " + front_.targetReason());
+    if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
+      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
     for (const auto& [kind, text] : problems_.recent(kRecentS))
       problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
     problems.report(status, "tracking");
@@ -303,6 +305,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::WallTime subscribed_at_;              // zero while not subscribed (lazy, nobody listens)
   std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
+  std::vector<std::string> config_errors_;  // parameters refused at start (set in init)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
   static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images

@@ -633,11 +633,17 @@ static void checkMetricSource(PlaneNodeParams& p, std::vector<std::string>& erro
     errors.push_back("pose/" + error + "; using target");
     pose.metric_source = "target";
   }
+  if (const std::string problem = metricSourceProblem(p); !problem.empty())
+    errors.push_back(problem);
+}
+
+std::string metricSourceProblem(const PlaneNodeParams& p) {
+  const PoseParams& pose = p.pipeline.pose;
   if (pose.metric_source == "odometry" && p.odom_frame.empty())
-    errors.push_back("pose/metric_source odometry needs odom_frame: no metres until it is set");
+    return "pose/metric_source odometry needs odom_frame: no metres until it is set";
   if (pose.metric_source == "camera_height" && !(pose.floor.camera_height_m > 0))
-    errors.push_back(
-        "pose/metric_source camera_height needs pose/camera_height_m > 0: no metres until set");
+    return "pose/metric_source camera_height needs pose/camera_height_m > 0: no metres until set";
+  return {};
 }
 
 // tf frame names the table cannot check: tf2 refuses a leading '/', an empty map frame

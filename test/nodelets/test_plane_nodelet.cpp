@@ -982,6 +982,19 @@ TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
   EXPECT_TRUE(ros::param::get("/plane_detector/max_gap_s", stored));
   EXPECT_EQ(stored, 1.0);
   EXPECT_GE(planesNow(5.5, 4000), 2u);  // and the nodelet goes on
+  // Diagnostics name the refused value until a reconfigure is accepted.
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.value("problem: configuration").find("reconfigure: max_gap_s = nan"),
+            std::string::npos)
+      << diagnostics.value("problem: configuration");
+  gap.value = 1.0;
+  nan_gap.request.config.doubles = {gap};
+  EXPECT_TRUE(ros::service::call("/plane_detector/set_parameters", nan_gap));
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("problem: configuration"), "");
   // The YAML's nested values were the server's start, not the .cfg defaults.
   int max_groups = 0;
   EXPECT_TRUE(ros::param::get("/plane_detector/planes_groups_max_groups", max_groups));
@@ -1044,6 +1057,21 @@ TEST_F(PlaneNodeletTest, P_TargetNotSeenIsAWarning) {
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.message().find("start-up target not seen"), std::string::npos)
       << diagnostics.message();
+}
+
+// plane_detector_misconfigured (plane_nodelet.test): metric_source odometry without
+// odom_frame never gives metres: ERROR in diagnostics while it lasts (it said OK, "waiting
+// for odometry", with the reason only in the log at start; hostile try).
+TEST_F(PlaneNodeletTest, P2_AMetricSourceThatCannotStartIsAnError) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector_misconfigured: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
+  EXPECT_NE(diagnostics.message().find("metric_source odometry needs odom_frame"), std::string::npos)
+      << diagnostics.message();
+  // The healthy instance has no configuration problem.
+  DiagnosticsProbe healthy(nh_, "plane_detector: planes");
+  ASSERT_TRUE(healthy.waitFresh());
+  EXPECT_EQ(healthy.value("problem: configuration"), "");
 }
 
 // Odometry from tf for tracks whose camera frame is not in the tf tree (a driver's frame_id

@@ -498,6 +498,12 @@ TEST_F(TrackerNodeletTest, OutOfRangeParametersAreReplacedByDefaults) {
     EXPECT_GE(answers[msg->header.stamp.toNSec()]->id.size(), 45u);  // max_features "many": 50
   }
   std::printf("bad parameters: slowest answer %.0f ms\n", slowest * 1e3);
+  // A user at the robot sees it in diagnostics too, not only in the log at start.
+  DiagnosticsProbe diagnostics(nh_, "tracker_bad_params: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::WARN) << diagnostics.message();
+  const std::string said = diagnostics.value("problem: configuration");
+  EXPECT_EQ(said.rfind("WARN: 4 parameters refused, defaults used (see the log): ", 0), 0u) << said;
 }
 
 // Issue 15, case 15: two cameras alternating on one image topic are reported (WARN and

@@ -197,6 +197,9 @@ std::string parametersMarkdown();
 // validate() with the checks that tie two parameters together (rate window order).
 std::vector<std::string> validate(TrackerNodeParams& params);
 std::vector<std::string> validate(PlaneNodeParams& params);
+// Why the metric source set cannot give metres (odometry without odom_frame, camera_height
+// without a height), "" when it can: a configuration error that stays until fixed.
+std::string metricSourceProblem(const PlaneNodeParams& params);
 std::vector<std::string> validate(TrackerParams& params);
 std::vector<std::string> validate(PipelineParams& params);
 
