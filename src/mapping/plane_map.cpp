@@ -216,7 +216,8 @@ PlaneFit PlaneMap::fitObservation(const PlaneObservation& obs, int needed) const
 
 void PlaneMap::reset() {
   planes_.clear();
-  next_id_ = 1;
+  // next_id_ goes on: a plane's id is never reused (PlaneEstimate.msg), so a node keyed
+  // on ids does not take a plane of the map before a bag loop for one after it.
   vertical_.reset();
 }
 

@@ -166,9 +166,13 @@ TEST(PlaneMap, MemoryIsBounded) {
   for (int k = 0; k < 10; ++k)
     map.update({observe(kFloor, -0.8, 50000 + 30 * k, 30, 100 + k)}, 1010);
   for (const MapPlane& p : map.planes()) EXPECT_LE(p.points.size(), 50u);
+  int last_id = 0;
+  for (const MapPlane& p : map.planes()) last_id = std::max(last_id, p.id);
+  ASSERT_GT(last_id, 0);
   map.reset();
   EXPECT_TRUE(map.planes().empty());
-  EXPECT_EQ(map.update({observe(kWall, 0, 1, 20, 1)}, 2000)[0], 1);  // ids start over
+  // Ids are never reused, not even after a reset (a bag loop): the next one goes on.
+  EXPECT_GT(map.update({observe(kWall, 0, 1, 20, 1)}, 2000)[0], last_id);
 }
 
 // Issue 18: images from one spot repeat the same evidence; a plane is confirmed only

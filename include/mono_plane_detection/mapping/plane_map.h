@@ -125,6 +125,7 @@ class PlaneMap {
   // planes are held level or upright by it. None until set, and after reset().
   void setVertical(const std::optional<cv::Vec3d>& up) { vertical_ = up; }
   const std::optional<cv::Vec3d>& vertical() const { return vertical_; }
+  // Empties the map; plane ids go on from the last one given (never reused).
   void reset();
 
  private:
