@@ -17,6 +17,10 @@ namespace {
 // sheet on the floor seen by such a camera is 90 deg - its pitch away.
 constexpr double kUprightCameraMaxDeg = 45.0;
 
+// Images between two odometry checks (odometry_check.h): a misconfigured odometry is
+// wrong in every image, so a check every sixth of a second at 30 Hz finds it within 2 s.
+constexpr long kOdometryCheckEvery = 5;
+
 double jaccard(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
   const std::unordered_set<std::uint64_t> in_a(a.begin(), a.end());
   size_t both = 0;
@@ -72,6 +76,7 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   history_.clear();
   previous_planes_.clear();
   motion_planes_.clear();
+  odometry_monitor_.reset();
   return {};
 }
 
@@ -84,6 +89,7 @@ void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap,
 
 void PlanePipeline::reset() {
   if (pose_) pose_->reset();
+  odometry_monitor_.reset();
   map_.reset();
   vertical_decided_ = false;
   pending_.clear();
@@ -130,7 +136,8 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     if (index < 0) {
       result.pure_rotation = true;
     } else {
-      const TrackFrame& reference = history_[static_cast<size_t>(index)].frame;
+      const PastFrame& past = history_[static_cast<size_t>(index)];
+      const TrackFrame& reference = past.frame;
       result.reference_stamp = reference.stamp;
       result.pairs = matchById(reference, frame);
       if (result.pairs.ids.size() >= 5) {
@@ -143,6 +150,30 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
           for (int i : p.inliers) image_plane.inlier_ids.push_back(result.pairs.ids[i]);
           result.planes.push_back(std::move(image_plane));
         }
+      }
+      // The odometry's motion against the tracks' (odometry_check.h), every
+      // kOdometryCheckEvery images (0.5 ms a check): said, not acted on. Only where the
+      // tracks determine the motion: planes other than the largest hold min_plane_support
+      // of them (the tracks of one wall leave its direction two-fold ambiguous).
+      long off_largest = 0;
+      for (int label : result.segmentation.labels) off_largest += label >= 2;
+      if (off_largest >= params_.planes.min_plane_support && result.pose &&
+          result.pose->source == PoseSource::kOdometry && past.odometry &&
+          past.map_from_camera && past.normalized.size() == reference.ids.size() &&
+          image_count_ % kOdometryCheckEvery == 0) {
+        std::unordered_map<std::uint64_t, size_t> now;
+        for (size_t i = 0; i < frame.ids.size(); ++i) now.emplace(frame.ids[i], i);
+        std::vector<cv::Point2d> a, b;
+        for (size_t i = 0; i < reference.ids.size(); ++i) {
+          const auto it = now.find(reference.ids[i]);
+          if (it == now.end()) continue;
+          a.push_back(past.normalized[i]);
+          b.push_back(normalized[it->second]);
+        }
+        result.odometry_check = checkOdometryMotion(
+            a, b, result.pose->map_from_camera.inverse() * *past.map_from_camera,
+            result.parallax_px, result.segmentation.noise_px, 0.5 * (K_(0, 0) + K_(1, 1)));
+        odometry_monitor_.add(result.odometry_check);
       }
     }
   }

@@ -22,6 +22,8 @@ struct RoomRun {
   std::vector<TruthPlane> truth;
   double worst_camera_m = 0, travelled_m = 0;
   int posed = 0;
+  int odometry_checks = 0, odometry_disagreeing = 0;  // odometry_check.h's, decided
+  bool odometry_alarm = false;                         // the monitor's, at any image
 };
 
 // odometry: the true camera poses as tf odom -> camera (metric_source odometry), the map
@@ -75,6 +77,9 @@ RoomRun runFurnished(const std::string& path, bool odometry = false,
     const PipelineResult result =
         odometry ? pipeline.process(frame, world_from_camera) : pipeline.process(frame);
     const Pose truth = odometry ? world_from_camera : map_from_world * world_from_camera;
+    run.odometry_checks += result.odometry_check.decided;
+    run.odometry_disagreeing += result.odometry_check.decided && !result.odometry_check.agrees;
+    run.odometry_alarm |= pipeline.odometryMonitor().disagrees();
     if (k > 0) run.travelled_m += cv::norm(truth.t - last);
     last = truth.t;
     if (result.pose) {
@@ -204,4 +209,9 @@ TEST(FurnishedRoom, WheeledPathWithOdometry) {
   EXPECT_LT(run.eval.worst_normal_error_deg, 0.8);
   EXPECT_LT(run.eval.worst_distance_error_m, 0.02);
   EXPECT_EQ(run.posed, 300);
+  // The true odometry agrees with the tracks of real textures (odometry_check.h).
+  std::printf("odometry checks: %d, %d disagreeing\n", run.odometry_checks,
+              run.odometry_disagreeing);
+  EXPECT_GT(run.odometry_checks, 5);
+  EXPECT_FALSE(run.odometry_alarm);
 }

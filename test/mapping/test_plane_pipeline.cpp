@@ -480,3 +480,38 @@ TEST(PlanePipeline, WithKnownPosesPlanesAreMappedBeforeTheirLandmarks) {
   EXPECT_LT(with.worst_normal_error_deg, 2.0);
   EXPECT_LT(with.worst_distance_error_m, 0.05);
 }
+
+// Odometry poses are checked against the tracks (odometry_check.h): the truth agrees; an
+// odom_frame that moves with the robot (its "odometry" turns the camera but never moves
+// it: base_link through a head's joints, a hostile try) disagrees, and the monitor says so.
+TEST(PlanePipeline, OdometryThatDoesNotMoveTheCameraAsItsImagesShowIsFound) {
+  const SyntheticTracks world("wheeled");
+  auto run = [&](bool travel, int& decided, int& disagreeing) {
+    PipelineParams params;
+    params.pose.metric_source = "odometry";
+    PlanePipeline pipeline(params);
+    pipeline.setCamera(world.camera.K(), world.camera.distortion());
+    decided = disagreeing = 0;
+    for (int k = 0; k < 200; ++k) {  // the alarm came at image 150 (7 of 10 checks)
+      const double t = k / 30.0;
+      Pose odometry = world.truthMapFromCamera(t);
+      if (!travel) odometry.t = world.truthMapFromCamera(0).t;  // turns, never moves
+      const PipelineResult r = pipeline.process(world.frame(t), odometry);
+      decided += r.odometry_check.decided;
+      disagreeing += r.odometry_check.decided && !r.odometry_check.agrees;
+    }
+    return pipeline.odometryMonitor().summary();
+  };
+  int decided = 0, disagreeing = 0;
+  EXPECT_EQ(run(true, decided, disagreeing), "");
+  std::printf("true odometry: %d of %d checks disagree\n", disagreeing, decided);
+  // One image in 5 is checked, where planes other than the largest hold 8 tracks.
+  EXPECT_GE(decided, 10);
+  EXPECT_EQ(disagreeing, 0);
+  const std::string said = run(false, decided, disagreeing);
+  std::printf("odometry without travel: %d of %d checks disagree: %s\n", disagreeing, decided,
+              said.c_str());
+  EXPECT_GE(decided, 10);
+  EXPECT_GE(disagreeing, decided * 9 / 10);
+  EXPECT_EQ(said.rfind("its translation ", 0), 0u) << said;
+}

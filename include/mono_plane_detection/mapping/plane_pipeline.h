@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mono_plane_detection/planes/homography_voting.h"
+#include "mono_plane_detection/mapping/odometry_check.h"
 #include "mono_plane_detection/mapping/plane_map.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
 #include "mono_plane_detection/tracking/stream_gaps.h"
@@ -90,6 +91,8 @@ struct PipelineResult {
   // The motion since the images within reach is (nearly) a pure rotation: no planes
   // were segmented (status says so).
   bool pure_rotation = false;
+  // With odometry poses here and at the reference: whether they explain the tracks.
+  OdometryCheck odometry_check;
   TrackPairs pairs;             // reference/current pixels the planes were found in
   PlaneSegmentation segmentation;    // over `pairs`
 };
@@ -112,6 +115,8 @@ class PlanePipeline {
   // first placed image with metres.
   bool verticalDecided() const { return vertical_decided_; }
   const PoseEstimator* poseEstimator() const { return pose_ ? &*pose_ : nullptr; }
+  // The odometry's recent checks against the tracks (PipelineResult::odometry_check).
+  const OdometryMonitor& odometryMonitor() const { return odometry_monitor_; }
   const PipelineParams& params() const { return params_; }
   // The parameters read anew on every image (planes/..., frame_gap, max_gap_s): the next
   // image uses them (dynamic_reconfigure); the others need a new pipeline.
@@ -169,6 +174,7 @@ class PlanePipeline {
     double normal_weight = 0, distance_sum = 0, distance_weight = 0;
   };
   std::map<int, MotionPlaneState> motion_planes_;
+  OdometryMonitor odometry_monitor_;
   long image_count_ = 0;
 };
 
