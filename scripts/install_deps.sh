@@ -18,7 +18,7 @@ PACKAGES=(
   python3-geometry-msgs python3-visualization-msgs
   libyaml-cpp-dev libopencv-dev libopencv-contrib-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
-  libstd-srvs-dev
+  libstd-srvs-dev python3-std-srvs python3-rosservice
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 

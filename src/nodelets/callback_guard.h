@@ -5,6 +5,7 @@
 #pragma once
 
 #include <ros/console.h>
+#include <ros/time.h>
 
 #include <atomic>
 #include <boost/function.hpp>
@@ -58,14 +59,18 @@ class CallbackGuard {
   void caught(const char* callback, const char* what) noexcept {
     try {
       ++count_;
+      bool log = false;
       {
         std::lock_guard<std::mutex> lock(mutex_);
         last_ = std::string(callback) + ": " + what;
+        // At most one line per 5 s of wall time (ROS time stands or goes back in a replay).
+        const ros::WallTime now = ros::WallTime::now();
+        log = last_logged_.isZero() || (now - last_logged_).toSec() >= 5.0;
+        if (log) last_logged_ = now;
       }
-      ROS_ERROR_STREAM_THROTTLE_NAMED(5.0, logger_, "exception in the " << callback
-                                                                       << " callback (" << what
-                                                                       << "): this call dropped, "
-                                                                          "state kept");
+      if (log)
+        ROS_ERROR_STREAM_NAMED(logger_, "exception in the " << callback << " callback (" << what
+                                                            << "): this call dropped, state kept");
     } catch (...) {  // logging itself failed (out of memory): nothing more to do
     }
   }
@@ -74,6 +79,7 @@ class CallbackGuard {
   std::atomic<long> count_{0};
   mutable std::mutex mutex_;
   std::string last_;
+  ros::WallTime last_logged_;
 };
 
 // A nodelet's onInit: nodelet's Loader deletes a nodelet whose onInit threw only after

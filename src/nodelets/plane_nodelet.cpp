@@ -35,6 +35,7 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
+#include "mono_plane_detection/tracking/stream_gaps.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
@@ -353,6 +354,43 @@ class PlaneNodelet : public nodelet::Nodelet {
   // count in ros::Time, which a looping bag sets back, silencing them for a whole loop.
   bool logNow(const std::string& kind, double period_s) { return logged_.note(kind, "", period_s); }
 
+  // The odometry moves the camera otherwise than its images show (odometry_check.h), and
+  // what to look at: the two configuration errors that do it (hostile try: odom_frame
+  // base_link on a humanoid left the map empty with every status OK).
+  std::string odometryMismatchText() const {
+    return "the odometry (tf " + odom_frame_ + " -> camera) does not move the camera as its "
+           "images show: " + pipeline_->odometryMonitor().summary() +
+           "; is odom_frame the odometry's fixed frame (odom, not base_link or another frame "
+           "on the robot), and the images' frame_id the camera's optical frame (z forward, x "
+           "right, y down)?";
+  }
+
+  // Tracks missing from the stream by their stamps (mutex_ held): the tracker's images it
+  // never got and tracks this nodelet's queue dropped; roscpp reports neither.
+  void countMissingTracks(const ros::Time& stamp) {
+    const uint64_t ns = stamp.toNSec();
+    long missing = 0;
+    if (last_tracks_ns_ != 0 && ns > last_tracks_ns_) {
+      const auto interval = static_cast<int64_t>(ns - last_tracks_ns_);
+      if (tracks_gaps_.isPause(interval, params_.max_gap_s))
+        tracks_gaps_.addPause(interval);
+      else
+        missing = tracks_gaps_.add(interval);
+    } else if (ns < last_tracks_ns_) {
+      tracks_gaps_.reset();  // time went back: a new stream
+    }
+    last_tracks_ns_ = ns;
+    missing_tracks_ += missing;
+    tracks_window_.add(1, missing);
+  }
+
+  // Tracks for kCameraInfoGraceS of wall time without a usable camera_info: the first
+  // tracks of a bag or a driver often come before it (a WARN at every start before).
+  bool cameraInfoOverdue() const {
+    return !first_tracks_.isZero() &&
+           (ros::WallTime::now() - first_tracks_).toSec() > kCameraInfoGraceS;
+  }
+
   bool onSaveMap(SaveMap::Request& req, SaveMap::Response& res) {
     guard_.run("save_map", [&] {
       PlaneArrayConstPtr planes;
@@ -396,9 +434,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   // tf_problem: why tf links no odometry to these tracks' camera at all ("" when it does,
   // or when only this stamp is missing: the odometry stopped or is late).
   // rigid: tf_problem is odom_frame rigid with the camera (a configuration error).
+  // stale_link: when only this stamp is missing, the link between them that lacks it.
   std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem,
-                               bool& rigid) {
+                               bool& rigid, std::string& stale_link) {
     tf_problem.clear();
+    stale_link.clear();
     rigid = false;
     if (odom_frame_.empty()) return {};
     tf_problem = rigidOdomFrame(tfFrame(header.frame_id));
@@ -433,6 +473,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       return odom;
     } catch (const tf2::TransformException& e) {
       tf_problem = odometryTfProblem(tfFrame(header.frame_id));
+      if (tf_problem.empty()) stale_link = staleLink(tfFrame(header.frame_id), header.stamp);
       if (!tf_problem.empty() ? logNow("odometry tf " + tf_problem, 10.0)
                               : logNow("odometry lookup", 10.0))
         NODELET_WARN("no %s -> %s transform at %.3f (%s): visual pose only%s%s",
@@ -440,6 +481,19 @@ class PlaneNodelet : public nodelet::Nodelet {
                      tf_problem.empty() ? "" : "; ", tf_problem.c_str());
       return {};
     }
+  }
+
+  // The first link on tf from the camera up to odom_frame that has no transform at stamp
+  // ("parent -> child"), "" when none is found: with a head on joints, joint states that
+  // stopped hold the images back as odometry that stopped would.
+  std::string staleLink(const std::string& camera, const ros::Time& stamp) const {
+    std::string frame = camera, parent;
+    for (int depth = 0; depth < 64 && frame != odom_frame_; ++depth) {
+      if (!tf_buffer_->_getParent(frame, ros::Time(0), parent)) return {};
+      if (!tf_buffer_->canTransform(parent, frame, stamp)) return parent + " -> " + frame;
+      frame = parent;
+    }
+    return {};
   }
 
   // odom_frame reached from the camera by static links only (/tf_static: a URDF's mount,
@@ -478,11 +532,18 @@ class PlaneNodelet : public nodelet::Nodelet {
              fix;
     if (!tf_buffer_->_frameExists(odom_frame_))
       return "odom_frame '" + odom_frame_ + "' is not on tf: no odometry published (yet)";
-    if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0)))
-      return "camera frame '" + camera +
-             "' (the images' header.frame_id) is not connected to "
-             "odom_frame '" +
-             odom_frame_ + "' on tf" + fix;
+    if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0))) {
+      // Where the camera's chain ends: a URDF frame whose joint's publisher has not sent
+      // yet (robot_state_publisher at start) is no wrong frame_id.
+      std::string top = camera, parent;
+      for (int depth = 0; depth < 64 && tf_buffer_->_getParent(top, ros::Time(0), parent); ++depth)
+        top = parent;
+      return "camera frame '" + camera + "' (the images' header.frame_id) is not connected to " +
+             "odom_frame '" + odom_frame_ + "' on tf (yet): its tf goes up to '" + top +
+             "' only; the link above that is missing (its publisher not running yet, e.g. "
+             "robot_state_publisher, or the odometry's odom -> base_link), or the frame_id is "
+             "not a frame of the robot's URDF";
+    }
     return {};
   }
 
@@ -728,10 +789,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   void process(const Tracks& msg, TrackFrame frame) {
     const ros::WallTime started = ros::WallTime::now();
     const bool before_jump = fromBeforeClockJump(msg.header.stamp);
-    std::string odom_tf_problem;
+    std::string odom_tf_problem, odom_stale_link;
     bool odom_rigid = false;
     const std::optional<Pose> odom =
-        before_jump ? std::nullopt : odometry(msg.header, odom_tf_problem, odom_rigid);
+        before_jump ? std::nullopt
+                    : odometry(msg.header, odom_tf_problem, odom_rigid, odom_stale_link);
     PlaneArrayPtr planes, image_planes;
     geometry_msgs::PoseStampedPtr pose;
     visualization_msgs::MarkerArrayPtr markers;
@@ -756,6 +818,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       if (!msg.header.frame_id.empty()) last_frame_id_ = msg.header.frame_id;
       last_tracks_size_ = frame.size;
+      if (first_tracks_.isZero()) first_tracks_ = ros::WallTime::now();
       // Corners of a target of another size than ours would fix a wrong scale (two
       // nodelets configured apart): refused, loudly, until they agree. Every message says
       // the tracker's target, so a tracker relaunched with the right one clears it at once.
@@ -787,7 +850,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       } else if (pipeline_->hasCamera()) {  // (the map of that camera does not apply)
         pipeline_ = std::make_unique<PlanePipeline>(params_);
         mapStartedOver();
-      } else if (!calibration_.latest() && logNow("no camera_info", 10.0)) {
+      } else if (!calibration_.latest() && cameraInfoOverdue() && logNow("no camera_info", 10.0)) {
         NODELET_WARN("tracks arrive but no usable camera_info on %s: image-space planes only",
                      info_sub_.getTopic().c_str());
       }
@@ -805,6 +868,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         odom_tf_problem_ = odom_tf_problem;
         odom_rigid_ = odom_rigid;
         odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
+        odom_stale_link_ = odom_stale_link;
       }
       if (result.was_reset) {
         // Rare (a bag loop): every time while loops come at most once a second, on the
@@ -818,6 +882,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         mapStartedOver(true);
         ++resets_;
         ++backwards_resets_;
+        backwards_window_.add(1);
         // Under simulated time the listener cleared its buffer when it saw the clock go
         // back, then took in what was queued before the jump: our own transform of the
         // previous loop's last images among it (measured: 59 TF_OLD_DATA in a loop of the
@@ -828,6 +893,8 @@ class PlaneNodelet : public nodelet::Nodelet {
         // own remedy; the static links stay): the new loop's transforms refill it.
         if (tf_buffer_) tf_buffer_->clear();
       }
+      if (pipeline_->odometryMonitor().disagrees() && logNow("odometry mismatch", 10.0))
+        NODELET_ERROR("%s", odometryMismatchText().c_str());
       if (result.tracking_loss && logNow("tracking loss", 5.0))
         NODELET_WARN(
             "%.3f s without tracks: tracking lost, waiting for %s to place the camera "
@@ -836,9 +903,13 @@ class PlaneNodelet : public nodelet::Nodelet {
             !odom_frame_.empty()                                  ? "the odometry"
             : node_.pipeline.pose.metric_source == "camera_height" ? "the map"
                                                                    : "the map or the target");
-      if (result.state != last_state_) {
+      // One line per change of the status (the pose's source too: "tracking (target)" ->
+      // "(odometry)" went unsaid), not of its "; too little parallax (...)" remark.
+      const std::string status_key = result.status.substr(0, result.status.find(';'));
+      if (result.state != last_state_ || status_key != last_status_key_) {
         NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
+        last_status_key_ = status_key;
       }
       // Waited in tracks stamps over the stretches of the stream (a pause or a jump of the
       // stamps is a tracking loss, time going back a reset: each closes one), since the
@@ -850,6 +921,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         target_wait_.reset();
       }
       ++frames_;
+      countMissingTracks(msg.header.stamp);
       status_ = result.status;
       state_ = result.state;
       observed_ = result.planes.size();
@@ -918,7 +990,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     // (Now: a camera_info or tracks of the right size clear it at once.)
     const std::string info_mismatch = calibration_.mismatch(last_tracks_size_);
     if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
-    if (frames_ > 0 && !calibration_.latest())
+    if (frames_ > 0 && !calibration_.latest() && cameraInfoOverdue())
       problems.add(DiagnosticStatus::WARN, "camera_info",
                    "tracks arrive but no usable camera_info");
     if (state_ == PipelineState::kLost)
@@ -928,6 +1000,19 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!odom_tf_problem_.empty())  // (a rigid odom_frame is a configuration error)
       problems.add(odom_rigid_ ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, "odometry",
                    "no odometry: " + odom_tf_problem_);
+    else if (pipeline_->odometryMonitor().disagrees())
+      problems.add(DiagnosticStatus::ERROR, "odometry", odometryMismatchText());
+    else if (odometry_stopped_ && !odom_stale_link_.empty() &&
+             odom_stale_link_.rfind(odom_frame_ + " -> ", 0) != 0)
+      // Not the odometry's own link: another publisher between it and the camera.
+      problems.add(DiagnosticStatus::WARN, "odometry",
+                   "tf " + odom_stale_link_ + " (between the camera and odom_frame '" +
+                       odom_frame_ + "') is more than odom_wait_s (" + secondsText(odom_wait_s_) +
+                       ") behind the images: its publisher (robot_state_publisher with "
+                       "/joint_states for a joint) stopped or is late; " +
+                       (metric_source_ == "odometry"
+                            ? std::string("camera pose from vision only")
+                            : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
     else if (odometry_stopped_)
       problems.add(DiagnosticStatus::WARN, "odometry",
                    "odometry (" + odom_frame_ + ") stopped, or more than odom_wait_s (" +
@@ -946,6 +1031,19 @@ class PlaneNodelet : public nodelet::Nodelet {
                               "with camera_height_m)"
                         : "no metric start (" + status_ + ") for " +
                               std::to_string(static_cast<long>(waited_s)) + " s"));
+    // The stream lately (as the tracker's): tracks lost before they reached us, and time
+    // going back again and again.
+    const auto [received, missing] = tracks_window_.sums();
+    const std::string missing_text = missingShareText(
+        received, missing, "tracks",
+        "images the tracker never got, or this nodelet's queue overflowed: the map is slower "
+        "than the stream, e.g. under CPU load");
+    if (!missing_text.empty()) problems.add(DiagnosticStatus::WARN, "tracks missing", missing_text);
+    if (const long back = backwards_window_.sums().first; back >= kBackwardsFlood)
+      problems.add(DiagnosticStatus::WARN, "time",
+                   "time went backwards " + std::to_string(back) +
+                       " times in the last 10 s, the map starting over each time: two "
+                       "publishers on one tracks topic, or two /clock sources?");
     // Other refused values were replaced by their defaults: after the present problems.
     if (blocked.empty() && (!start_errors_.empty() || !reconfigure_errors_.empty())) {
       std::vector<std::string> all = start_errors_;
@@ -964,6 +1062,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.add("odometry waited for in vain (total)", odom_waits_in_vain_.load());
     status.add("images processed", frames_);
     status.add("tracks messages dropped", dropped_);
+    status.add("tracks missing from the stream (total)", missing_tracks_);
     status.add("camera_info messages rejected", dropped_info_);
     // The calibration of the last tracks' size (before any: the last camera_info).
     status.add("camera model", cameraModelName(calibration_, last_tracks_size_));
@@ -1040,6 +1139,15 @@ class PlaneNodelet : public nodelet::Nodelet {
   bool reset_markers_ = false;
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
+  std::string last_status_key_;  // the status last logged, without its "; ..." remark
+  static constexpr double kCameraInfoGraceS = 5.0;  // as the tracker's
+  static constexpr long kBackwardsFlood = 3;  // times back in 10 s: two sources (a loop: 1)
+  GapCounter tracks_gaps_;         // the tracks stream's rhythm (countMissingTracks)
+  uint64_t last_tracks_ns_ = 0;
+  long missing_tracks_ = 0;        // tracks missing from the stream, total
+  WindowCounts tracks_window_;     // tracks received, tracks found missing (last 10 s)
+  WindowCounts backwards_window_;  // times the stamps went back (last 10 s)
+  ros::WallTime first_tracks_;  // wall time of the first tracks (camera_info's grace)
   long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
@@ -1054,6 +1162,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   PlaneArrayConstPtr last_planes_;
   std::string metric_source_;     // the source that started the map, "" before
   bool odometry_stopped_ = false;  // odom_frame set but no odometry for the last image
+  std::string odom_stale_link_;    // then the link on tf that lacked its stamp, if found
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)

@@ -66,6 +66,54 @@ class RecentEvents {
   std::map<std::string, Event> events_;
 };
 
+// Counts over the last window of wall time (images received and found missing, resets):
+// what diagnostics judge a stream by now, not since the start. Thread-safe.
+class WindowCounts {
+ public:
+  explicit WindowCounts(double window_s = 10.0) : window_s_(window_s) {}
+  void add(long a, long b = 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::WallTime now = ros::WallTime::now();
+    forget(now);
+    entries_.push_back({now, a, b});
+  }
+  // The sums of a and of b over the window.
+  std::pair<long, long> sums() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const ros::WallTime now = ros::WallTime::now();
+    std::pair<long, long> out{0, 0};
+    for (const Entry& e : entries_)
+      if ((now - e.at).toSec() <= window_s_) {
+        out.first += e.a;
+        out.second += e.b;
+      }
+    return out;
+  }
+
+ private:
+  struct Entry {
+    ros::WallTime at;
+    long a, b;
+  };
+  void forget(const ros::WallTime& now) {
+    while (!entries_.empty() && (now - entries_.front().at).toSec() > window_s_)
+      entries_.erase(entries_.begin());
+  }
+  double window_s_;
+  mutable std::mutex mutex_;
+  std::vector<Entry> entries_;  // oldest first
+};
+
+// "N of M images missing in the last 10 s ..." when over a tenth of a stream's images
+// (and at least 3) went missing in the window, "" otherwise: a stray drop is no problem,
+// a queue that overflows is (a tracker or map slower than the stream under load).
+inline std::string missingShareText(long received, long missing, const std::string& what,
+                                    const std::string& why) {
+  if (missing < 3 || 10 * missing <= received + missing) return {};
+  return std::to_string(missing) + " of " + std::to_string(received + missing) + " " + what +
+         " missing in the last 10 s (" + why + ")";
+}
+
 // The kind of a reason text, for RecentEvents: up to its first ':' or '(' (and a quoted
 // name in it: "unsupported encoding '32FC1'" and "... '16UC1'" are two kinds).
 inline std::string reasonKind(const std::string& reason) {

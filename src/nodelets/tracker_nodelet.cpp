@@ -132,7 +132,8 @@ class TrackerNodelet : public nodelet::Nodelet {
         error = std::string("cannot subscribe to ") + getNodeHandle().resolveName("image") +
                 " with image_transport '" + front_.params().image_transport + "' (" + why +
                 "): no tracks; install that transport or set image_transport: raw";
-        NODELET_ERROR_THROTTLE(10.0, "%s", error.c_str());  // (each listener retries)
+        // (each listener retries; throttled on wall time, as every log line here)
+        if (logged_.note("subscribe", error, 10.0)) NODELET_ERROR("%s", error.c_str());
       }
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       subscribe_error_ = error;
@@ -149,6 +150,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   void warn(const LogEvent& event) {
     // A camera switch is also a problem of the stream for diagnostics (while recent).
     if (event.kind == "camera switch") problems_.note("camera switch", "image stream mixes cameras");
+    if (event.kind == "backwards") backwards_window_.add(1);
     if (logged_.note(event.kind, event.text, 5.0, event.burst)) NODELET_WARN("%s", event.text.c_str());
   }
 
@@ -161,18 +163,20 @@ class TrackerNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(state_mutex_);
       if (first_image_.isZero()) first_image_ = started;
       last_image_ = started;
+      const long missing_before = front_.counts().missing;
       out = front_.process(msg);
+      stream_window_.add(1, front_.counts().missing - missing_before);
       for (const LogEvent& event : out.warnings) warn(event);
       // Not this image's camera (the front end does not use it): an ERROR, on wall time.
       if (!out.info_mismatch.empty() && logged_.note("info size", out.info_mismatch, 10.0))
         NODELET_ERROR("%s", out.info_mismatch.c_str());
       // Before target_timeout_s: why the target is not seen yet, now and then (after it, a
-      // WARN says so every 5 s).
+      // WARN says so every 5 s). On wall time: ROS time stands still under use_sim_time
+      // without /clock, and goes back in a bag loop (it was never said then; hostile try).
       if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
-          !front_.targetOverdue())
-        NODELET_INFO_THROTTLE(10.0, "waiting for the start-up target (%s): %s",
-                              front_.targetDescription().c_str(),
-                              front_.targetReason().c_str());
+          !front_.targetOverdue() && logged_.note("target wait", "", 10.0))
+        NODELET_INFO("waiting for the start-up target (%s): %s",
+                     front_.targetDescription().c_str(), front_.targetReason().c_str());
       if (!out.tracks) {
         // One throttle per reason: each kind of bad image is named at least once.
         if (problems_.note(reasonKind(out.dropped), "image dropped: " + out.dropped)) {
@@ -245,6 +249,19 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (no_target)
       problems.add(DiagnosticStatus::WARN, "start-up target",
                    "no start-up target: " + front_.targetReason());
+    // The stream lately: images lost before they reached us (a queue that overflows shows
+    // only as gaps in the stamps), and time going back again and again (two sources).
+    const auto [received, missing] = stream_window_.sums();
+    const std::string missing_text = missingShareText(
+        received, missing, "images",
+        "the subscriber queue overflowed: tracking is slower than the stream, e.g. under CPU "
+        "load; or the driver or the network dropped them");
+    if (!missing_text.empty()) problems.add(DiagnosticStatus::WARN, "images missing", missing_text);
+    if (const long back = backwards_window_.sums().first; back >= kBackwardsFlood)
+      problems.add(DiagnosticStatus::WARN, "time",
+                   "time went backwards " + std::to_string(back) +
+                       " times in the last 10 s, tracking starting over each time: two "
+                       "publishers on one image topic, or two /clock sources?");
     if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
       problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
     for (const auto& [kind, text] : problems_.recent(kRecentS))
@@ -306,6 +323,10 @@ class TrackerNodelet : public nodelet::Nodelet {
   std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
   std::vector<std::string> config_errors_;  // parameters refused at start (set in init)
+  WindowCounts stream_window_;     // images received, images found missing (last 10 s)
+  WindowCounts backwards_window_;  // times the stamps went back (last 10 s)
+  // A bag loop goes back once; this many times in 10 s is a flood (two sources).
+  static constexpr long kBackwardsFlood = 3;
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
   static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images

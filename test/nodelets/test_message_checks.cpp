@@ -370,6 +370,27 @@ TEST(StatusProblems, EveryProblemHasItsKeyAndTheWorstIsTheSummary) {
   EXPECT_EQ(value(fine, "problems now"), "0");
 }
 
+TEST(WindowCounts, SumsTheLastWindowOnly) {
+  WindowCounts counts(0.3);
+  counts.add(1, 0);
+  counts.add(1, 2);
+  EXPECT_EQ(counts.sums(), std::make_pair(2L, 2L));
+  ros::WallDuration(0.4).sleep();
+  counts.add(1, 1);
+  EXPECT_EQ(counts.sums(), std::make_pair(1L, 1L));  // the first two are out of the window
+  ros::WallDuration(0.4).sleep();
+  EXPECT_EQ(counts.sums(), std::make_pair(0L, 0L));
+}
+
+TEST(WindowCounts, AMissingShareOverATenthIsAProblem) {
+  EXPECT_EQ(missingShareText(300, 2, "images", "why"), "");   // fewer than 3
+  EXPECT_EQ(missingShareText(300, 30, "images", "why"), "");  // a tenth at most
+  EXPECT_EQ(missingShareText(270, 30, "images", "why"), "");  // exactly a tenth
+  EXPECT_EQ(missingShareText(269, 31, "images", "queue full"),
+            "31 of 300 images missing in the last 10 s (queue full)");
+  EXPECT_EQ(missingShareText(0, 3, "tracks", "why"), "3 of 3 tracks missing in the last 10 s (why)");
+}
+
 TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
   using Recent = std::vector<std::pair<std::string, std::string>>;
   RecentEvents events;

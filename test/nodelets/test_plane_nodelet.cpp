@@ -9,6 +9,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <rosgraph_msgs/Log.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
@@ -445,6 +446,11 @@ TEST_F(PlaneNodeletTest, H_WithoutCameraInfoThePlanesStayInTheImage) {
   EXPECT_FALSE(r->metric);
   EXPECT_EQ(r->status, "no camera intrinsics: image-space planes only");
   EXPECT_TRUE(r->planes.empty());
+  // Its diagnostics say so, once camera_info's grace (5 s of tracks) is over (the tests
+  // before ran longer); the first tracks of a bag often come before camera_info.
+  DiagnosticsProbe diagnostics(nh_, "plane_detector_no_info: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("problem: camera_info"), "WARN: tracks arrive but no usable camera_info");
 }
 
 // The robot's odometry: tf odom -> camera_optical for every image (the true pose seen
@@ -458,6 +464,13 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   ASSERT_TRUE(linked(other.tracks, other.planes));
+  std::vector<std::string> logged;  // INFO lines on /rosout (only this instance gets tracks)
+  ros::Subscriber rosout = nh_.subscribe<rosgraph_msgs::Log>(
+      "/rosout", 200, [&](const rosgraph_msgs::LogConstPtr& m) {
+        if (m->level == rosgraph_msgs::Log::INFO) logged.push_back(m->msg);
+      });
+  ASSERT_TRUE(spinUntil([&] { return rosout.getNumPublishers() > 0; }, 10.0));
+  ros::WallDuration(0.3).sleep();
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;
   for (int k = 0; k < 90; ++k) {
@@ -477,6 +490,21 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
     ASSERT_TRUE(last) << "image " << k;
   }
   EXPECT_EQ(last->status, "tracking (odometry)");
+  // Every change of the status is logged once (hostile try: "tracking (target)" ->
+  // "tracking (odometry)" went unsaid; the remark after ';' is not a change).
+  spinUntil([] { return false; }, 0.5);
+  std::string previous;
+  int changes = 0;
+  for (const auto& [stamp, answer] : answers) {
+    if (stamp < ros::Time(world_->frame(0).stamp + 500).toNSec()) continue;  // this test's
+    const std::string key = answer->status.substr(0, answer->status.find(';'));
+    if (key == previous) continue;
+    previous = key;
+    ++changes;
+    EXPECT_NE(std::find(logged.begin(), logged.end(), answer->status), logged.end())
+        << "not logged: " << answer->status;
+  }
+  EXPECT_GE(changes, 2);
   const Pose truth = world_->truthMapFromCamera(89 / 30.0);
   const Pose in_ros_map = targetFromRosMap(fromPoseMsg(last->camera_pose));
   EXPECT_NEAR(in_ros_map.t[0], truth.t[0], 0.1);
@@ -567,6 +595,51 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
   }
   EXPECT_LE(missed_after_pause, 2) << "of the images after the odometry came back";
   EXPECT_LT(worst_step, 0.05);  // 0.01 m per image
+  // The true odometry agrees with the images (odometry_check.h).
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("problem: odometry").find("does not move the camera"),
+            std::string::npos)
+      << diagnostics.value("problem: odometry");
+}
+
+// Odometry that turns the camera but never moves it (odom_frame:=base_link on a humanoid,
+// whose head turns on joints: a hostile try got an empty map and every status OK): an
+// ERROR that names the two configuration errors that do this.
+TEST_F(PlaneNodeletTest, I2b_OdometryThatDoesNotMoveTheCameraIsAnError) {
+  OtherNodelet other(nh_, "odom_source", 20, 50);
+  tf2_ros::TransformBroadcaster broadcaster;
+  ASSERT_TRUE(linked(other.tracks, other.planes));
+  ros::WallDuration(0.5).sleep();  // the nodelet's tf listener hears the new broadcaster
+  const Pose start = rosMapFromTarget() * world_->truthMapFromCamera(0);
+  for (int k = 0; k < 200; ++k) {  // (checks at one image in 5 with two planes in view)
+    const double t = k / 30.0;
+    TrackFrame f = world_->frame(t);
+    for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;
+    f.stamp += 3510;  // after I2's time line
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(f.stamp);
+    tf.header.frame_id = "odom_source";
+    tf.child_frame_id = "camera_optical_source";
+    Pose turned_only = rosMapFromTarget() * world_->truthMapFromCamera(t);
+    turned_only.t = start.t;
+    tf.transform = toTransformMsg(turned_only);
+    broadcaster.sendTransform(tf);
+    ros::WallDuration(0.02).sleep();
+    TracksPtr msg = toTracks(f);
+    msg->header.frame_id = "camera_optical_source";
+    other.tracks.publish(msg);
+    ASSERT_TRUE(waitFor(other.answers, msg->header.stamp.toNSec())) << k;
+  }
+  ASSERT_TRUE(other.diagnostics.waitFresh());
+  ASSERT_TRUE(other.diagnostics.waitFresh());
+  EXPECT_EQ(other.diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR)
+      << other.diagnostics.message();
+  const std::string said = other.diagnostics.value("problem: odometry");
+  EXPECT_NE(said.find("ERROR: the odometry (tf odom_source -> camera) does not move the camera "
+                      "as its images show: its translation 1"),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("is odom_frame the odometry's fixed frame"), std::string::npos) << said;
 }
 
 // Odometry that always lags more than odom_wait_s (0.4 s against 0.25 s): after one wait
@@ -1106,6 +1179,62 @@ TEST_F(PlaneNodeletTest, Q_CameraFrameMissingFromTfIsNamed) {
       << other.diagnostics.message();
 }
 
+// A head on joints (hostile try, humanoid URDF): odom -> body (odometry), body -> head (a
+// joint, robot_state_publisher), head -> camera. Before the joint's first transform the
+// camera's chain ends at the head: said so (it blamed the images' frame_id); when the joint
+// states stop while the odometry runs, the joint's link is named (it blamed the odometry).
+TEST_F(PlaneNodeletTest, Q2_AJointLinkMissingOrStaleIsNamed) {
+  OtherNodelet other(nh_, "odom", 20, 50);
+  ASSERT_TRUE(linked(other.tracks, other.planes));
+  tf2_ros::TransformBroadcaster broadcaster;
+  auto link = [](const std::string& parent, const std::string& child, double stamp,
+                 const Pose& pose) {
+    geometry_msgs::TransformStamped tf;
+    tf.header.stamp = ros::Time(stamp);
+    tf.header.frame_id = parent;
+    tf.child_frame_id = child;
+    tf.transform = toTransformMsg(pose);
+    return tf;
+  };
+  const Pose identity{cv::Matx33d::eye(), {0, 0, 0}};
+  // Image k: the odometry and the head's mount always, the joint when `joint` is true.
+  auto sendImage = [&](int k, bool joint) {
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += 6100;
+    std::vector<geometry_msgs::TransformStamped> out = {
+        link("odom", "body_q", f.stamp, world_->truthMapFromCamera(k / 30.0)),
+        link("head_q", "camera_head_q", f.stamp, identity)};
+    if (joint) out.push_back(link("body_q", "head_q", f.stamp, identity));
+    broadcaster.sendTransform(out);
+    ros::WallDuration(0.02).sleep();  // let tf arrive before the tracks
+    TracksPtr msg = toTracks(f);
+    msg->header.frame_id = "camera_head_q";
+    other.tracks.publish(msg);
+    return waitFor(other.answers, msg->header.stamp.toNSec()) != nullptr;
+  };
+  auto odometryProblem = [&] {
+    other.diagnostics.waitFresh();
+    other.diagnostics.waitFresh();
+    return other.diagnostics.value("problem: odometry");
+  };
+  ros::WallDuration(0.5).sleep();  // the nodelet's tf listener hears the new broadcaster
+  for (int k = 0; k < 5; ++k) ASSERT_TRUE(sendImage(k, false)) << k;
+  std::string said = odometryProblem();
+  EXPECT_NE(said.find("is not connected to odom_frame 'odom' on tf (yet): its tf goes up to "
+                      "'head_q' only"),
+            std::string::npos)
+      << said;
+  for (int k = 5; k < 10; ++k) ASSERT_TRUE(sendImage(k, true)) << k;
+  said = odometryProblem();
+  EXPECT_EQ(said, "");
+  for (int k = 10; k < 16; ++k) ASSERT_TRUE(sendImage(k, false)) << k;
+  said = odometryProblem();
+  EXPECT_NE(said.find("tf body_q -> head_q (between the camera and odom_frame 'odom') is more "
+                      "than odom_wait_s"),
+            std::string::npos)
+      << said;
+}
+
 // A camera_info of another frame than the tracks' (another camera's, through a remap gone
 // wrong) is used all the same but counted and said (a hostile try found it silent).
 TEST_F(PlaneNodeletTest, R_CameraInfoOfAnotherFrameIsCounted) {
@@ -1133,6 +1262,46 @@ TEST_F(PlaneNodeletTest, R_CameraInfoOfAnotherFrameIsCounted) {
   }
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.number("tracks with camera_info of another frame_id (total)") - before, 5);
+}
+
+// Last (its WARNs last 10 s): tracks lost before they reach the nodelet (the tracker's
+// dropped images, a queue that overflows under load) show only as gaps in the stamps; a
+// hostile try saw 134 of 309 lost with the status OK. And stamps going back and forth
+// (two bags on one topic) started the map over 30 times a second with the status OK.
+TEST_F(PlaneNodeletTest, S_MissingTracksAndAFloodOfTimeJumpsAreWarnings) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long before = diagnostics.number("tracks missing from the stream (total)");
+  ASSERT_GE(before, 0);
+  // 30 Hz with every third image missing: intervals of 1, 1, 2 periods.
+  int sent = 0, k = 0;
+  while (sent < 40) {
+    if (k % 3 != 2) {
+      TrackFrame f = world_->frame(k / 30.0);
+      f.stamp += 8000;
+      ASSERT_TRUE(send(toTracks(f))) << k;
+      ++sent;
+    }
+    ++k;
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long missing = diagnostics.number("tracks missing from the stream (total)") - before;
+  EXPECT_GE(missing, 17);  // 19 gaps; the period is known after the first intervals
+  EXPECT_LE(missing, 20);
+  EXPECT_NE(diagnostics.value("problem: tracks missing").find("tracks missing in the last 10 s"),
+            std::string::npos)
+      << diagnostics.value("problem: tracks missing");
+  // Two sources interleaved: stamps back and forth.
+  for (int j = 0; j < 8; ++j) {
+    TrackFrame f = world_->frame(j / 30.0);
+    f.stamp += (j % 2 ? 8100 : 9100) + j / 30.0;
+    ASSERT_TRUE(send(toTracks(f))) << j;
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.value("problem: time").find("time went backwards"), std::string::npos)
+      << diagnostics.value("problem: time");
 }
 
 }  // namespace
