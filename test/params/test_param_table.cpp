@@ -150,6 +150,46 @@ TEST(ParamTable, ValidateNestedAndNodeParams) {
   EXPECT_EQ(p.expected_min_rate_hz, d.expected_min_rate_hz);
 }
 
+// The core's own parameters (no ROS: the offline tools, the tests) validate alike.
+TEST(ParamTable, ValidatePipelineParams) {
+  PipelineParams p;
+  EXPECT_TRUE(validate(p).empty());
+  p.frame_gap = 0;
+  p.map.max_planes = 0;
+  const auto errors = validate(p);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_NE(errors[0].find("frame_gap = 0"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[1].find("map/max_planes = 0"), std::string::npos) << errors[1];
+  EXPECT_EQ(p.frame_gap, PipelineParams().frame_gap);
+  EXPECT_EQ(p.map.max_planes, PipelineParams().map.max_planes);
+}
+
+// A metric source that cannot give metres is named (the plane nodelet's ERROR).
+TEST(ParamTable, MetricSourceProblems) {
+  PlaneNodeParams p;
+  EXPECT_EQ(metricSourceProblem(p), "");  // target
+  p.pipeline.pose.metric_source = "odometry";
+  EXPECT_EQ(metricSourceProblem(p),
+            "pose/metric_source odometry needs odom_frame: no metres until it is set");
+  p.odom_frame = "odom";
+  EXPECT_EQ(metricSourceProblem(p), "");
+  p.pipeline.pose.metric_source = "camera_height";
+  EXPECT_NE(metricSourceProblem(p).find("needs pose/camera_height_m > 0"), std::string::npos);
+  p.pipeline.pose.floor.camera_height_m = 1.2;
+  EXPECT_EQ(metricSourceProblem(p), "");
+}
+
+TEST(ParamTable, FieldValuesAsText) {
+  bool b = true;
+  int i = -3;
+  double d = 0.25;
+  std::string s = "odom";
+  EXPECT_EQ(toString(ParamField(&b)), "true");
+  EXPECT_EQ(toString(ParamField(&i)), "-3");
+  EXPECT_EQ(toString(ParamField(&d)), "0.25");
+  EXPECT_EQ(toString(ParamField(&s)), "\"odom\"");
+}
+
 // The hostile new-user try: map_frame "" was taken and put on tf as a frame named "".
 TEST(ParamTable, FrameNamesTfWouldRefuseAreRepaired) {
   PlaneNodeParams p;

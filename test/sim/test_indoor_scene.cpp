@@ -87,6 +87,18 @@ TEST(IndoorScene, TargetIsPaintedWhereItsCornersSay) {
   }
 }
 
+TEST(IndoorScene, APlaneContainsItsRectangleButNotItsHoles) {
+  ScenePlane wall;
+  wall.width_m = 4;
+  wall.height_m = 2.5;
+  wall.holes.push_back(cv::Rect2d(1.0, 0.0, 0.9, 2.0));  // a door
+  EXPECT_TRUE(wall.contains(0.5, 1.0));
+  EXPECT_TRUE(wall.contains(1.5, 2.2));   // above the door
+  EXPECT_FALSE(wall.contains(1.5, 1.0));  // in the door
+  EXPECT_FALSE(wall.contains(-0.1, 1.0));
+  EXPECT_FALSE(wall.contains(2.0, 2.6));
+}
+
 TEST(IndoorScene, PoseAlgebra) {
   Pose a{cv::Matx33d(0, -1, 0, 1, 0, 0, 0, 0, 1), {1, 2, 3}};
   const cv::Vec3d x(0.5, -2, 7);
