@@ -19,6 +19,7 @@ PACKAGES=(
   libyaml-cpp-dev libopencv-dev libopencv-contrib-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
   libstd-srvs-dev python3-std-srvs python3-rosservice
+  ros-image-proc
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 
