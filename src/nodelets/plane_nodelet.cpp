@@ -381,7 +381,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
     last_tracks_ns_ = ns;
     missing_tracks_ += missing;
-    tracks_window_.add(1, missing);
+    stream_health_.received(missing);
   }
 
   // Tracks for kCameraInfoGraceS of wall time without a usable camera_info: the first
@@ -844,6 +844,12 @@ class PlaneNodelet : public nodelet::Nodelet {
             NODELET_WARN("%s (%s)", other.c_str(), info_sub_.getTopic().c_str());
         }
       }
+      // The tracker's start-up target seen while the map could not use it (no camera):
+      // the tracker joins it once, so once its corners are gone the map waits for ever.
+      const bool target_in_tracks = std::find(frame.target_corner.begin(),
+                                              frame.target_corner.end(),
+                                              true) != frame.target_corner.end();
+      if (target_in_tracks) target_missed_ = !camera;
       if (camera) {
         pipeline_->setCamera(camera->K, camera->D);  // (checked on arrival; same: no change)
         undistortFisheye(frame, *camera);            // equidistant: pinhole pixels of the same K
@@ -882,7 +888,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         mapStartedOver(true);
         ++resets_;
         ++backwards_resets_;
-        backwards_window_.add(1);
+        stream_health_.wentBackwards();
         // Under simulated time the listener cleared its buffer when it saw the clock go
         // back, then took in what was queued before the jump: our own transform of the
         // previous loop's last images among it (measured: 59 TF_OLD_DATA in a loop of the
@@ -987,6 +993,11 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!target_mismatch_.empty())
       problems.add(DiagnosticStatus::ERROR, "start-up target",
                    "start-up target: " + target_mismatch_);
+    else if (target_missed_ && state_ == PipelineState::kWaitingForTarget)
+      problems.add(DiagnosticStatus::WARN, "start-up target",
+                   "the tracker found the start-up target before camera_info came, and it is "
+                   "not tracked any more: show it again and call the tracker's ~reset (it "
+                   "joins the target once), or publish camera_info with the first images");
     // (Now: a camera_info or tracks of the right size clear it at once.)
     const std::string info_mismatch = calibration_.mismatch(last_tracks_size_);
     if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
@@ -1031,19 +1042,13 @@ class PlaneNodelet : public nodelet::Nodelet {
                               "with camera_height_m)"
                         : "no metric start (" + status_ + ") for " +
                               std::to_string(static_cast<long>(waited_s)) + " s"));
-    // The stream lately (as the tracker's): tracks lost before they reached us, and time
-    // going back again and again.
-    const auto [received, missing] = tracks_window_.sums();
-    const std::string missing_text = missingShareText(
-        received, missing, "tracks",
-        "images the tracker never got, or this nodelet's queue overflowed: the map is slower "
-        "than the stream, e.g. under CPU load");
-    if (!missing_text.empty()) problems.add(DiagnosticStatus::WARN, "tracks missing", missing_text);
-    if (const long back = backwards_window_.sums().first; back >= kBackwardsFlood)
-      problems.add(DiagnosticStatus::WARN, "time",
-                   "time went backwards " + std::to_string(back) +
-                       " times in the last 10 s, the map starting over each time: two "
-                       "publishers on one tracks topic, or two /clock sources?");
+    // The stream lately (as the tracker's).
+    for (const auto& [key, text] : stream_health_.problems(
+             "tracks",
+             "images the tracker never got, or this nodelet's queue overflowed: the map is "
+             "slower than the stream, e.g. under CPU load",
+             "the map starting over", "tracks"))
+      problems.add(DiagnosticStatus::WARN, key, text);
     // Other refused values were replaced by their defaults: after the present problems.
     if (blocked.empty() && (!start_errors_.empty() || !reconfigure_errors_.empty())) {
       std::vector<std::string> all = start_errors_;
@@ -1141,12 +1146,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string status_;
   std::string last_status_key_;  // the status last logged, without its "; ..." remark
   static constexpr double kCameraInfoGraceS = 5.0;  // as the tracker's
-  static constexpr long kBackwardsFlood = 3;  // times back in 10 s: two sources (a loop: 1)
   GapCounter tracks_gaps_;         // the tracks stream's rhythm (countMissingTracks)
   uint64_t last_tracks_ns_ = 0;
   long missing_tracks_ = 0;        // tracks missing from the stream, total
-  WindowCounts tracks_window_;     // tracks received, tracks found missing (last 10 s)
-  WindowCounts backwards_window_;  // times the stamps went back (last 10 s)
+  StreamHealth stream_health_;     // tracks missing, time going back (last 10 s)
   ros::WallTime first_tracks_;  // wall time of the first tracks (camera_info's grace)
   long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
        resets_ = 0, reconfigures_ = 0;
@@ -1163,6 +1166,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string metric_source_;     // the source that started the map, "" before
   bool odometry_stopped_ = false;  // odom_frame set but no odometry for the last image
   std::string odom_stale_link_;    // then the link on tf that lacked its stamp, if found
+  // The last tracks with the start-up target's corners came without a camera (no
+  // camera_info): the map never saw the target (hostile try: camera_info 2.5 s late).
+  bool target_missed_ = false;
   std::string resolved_tf_mode_;  // above_odom | below_odom once decided
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)

@@ -114,6 +114,38 @@ inline std::string missingShareText(long received, long missing, const std::stri
          " missing in the last 10 s (" + why + ")";
 }
 
+// A stream's health lately, for diagnostics (both nodelets): messages lost before they
+// reached us (gaps in the stamps: a queue that overflows shows only there) and time going
+// back again and again (two sources on one topic). Thread-safe.
+class StreamHealth {
+ public:
+  // A bag loop goes back once; this many times in 10 s is a flood.
+  static constexpr long kBackwardsFlood = 3;
+  void received(long missing_found) { stream_.add(1, missing_found); }
+  void wentBackwards() { backwards_.add(1); }
+  // (key, text) of each problem now; what: "images" / "tracks"; why_missing: the likely
+  // causes; restarting: what starts over each time the stamps go back; topic: "image".
+  std::vector<std::pair<std::string, std::string>> problems(const std::string& what,
+                                                            const std::string& why_missing,
+                                                            const std::string& restarting,
+                                                            const std::string& topic) const {
+    std::vector<std::pair<std::string, std::string>> out;
+    const auto [received, missing] = stream_.sums();
+    const std::string text = missingShareText(received, missing, what, why_missing);
+    if (!text.empty()) out.emplace_back(what + " missing", text);
+    if (const long back = backwards_.sums().first; back >= kBackwardsFlood)
+      out.emplace_back("time", "time went backwards " + std::to_string(back) +
+                                   " times in the last 10 s, " + restarting +
+                                   " each time: two publishers on one " + topic +
+                                   " topic, or two /clock sources?");
+    return out;
+  }
+
+ private:
+  WindowCounts stream_;     // messages received, messages found missing
+  WindowCounts backwards_;  // times the stamps went back
+};
+
 // The kind of a reason text, for RecentEvents: up to its first ':' or '(' (and a quoted
 // name in it: "unsupported encoding '32FC1'" and "... '16UC1'" are two kinds).
 inline std::string reasonKind(const std::string& reason) {

@@ -150,7 +150,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   void warn(const LogEvent& event) {
     // A camera switch is also a problem of the stream for diagnostics (while recent).
     if (event.kind == "camera switch") problems_.note("camera switch", "image stream mixes cameras");
-    if (event.kind == "backwards") backwards_window_.add(1);
+    if (event.kind == "backwards") stream_health_.wentBackwards();
     if (logged_.note(event.kind, event.text, 5.0, event.burst)) NODELET_WARN("%s", event.text.c_str());
   }
 
@@ -165,7 +165,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       last_image_ = started;
       const long missing_before = front_.counts().missing;
       out = front_.process(msg);
-      stream_window_.add(1, front_.counts().missing - missing_before);
+      stream_health_.received(front_.counts().missing - missing_before);
       for (const LogEvent& event : out.warnings) warn(event);
       // Not this image's camera (the front end does not use it): an ERROR, on wall time.
       if (!out.info_mismatch.empty() && logged_.note("info size", out.info_mismatch, 10.0))
@@ -249,19 +249,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (no_target)
       problems.add(DiagnosticStatus::WARN, "start-up target",
                    "no start-up target: " + front_.targetReason());
-    // The stream lately: images lost before they reached us (a queue that overflows shows
-    // only as gaps in the stamps), and time going back again and again (two sources).
-    const auto [received, missing] = stream_window_.sums();
-    const std::string missing_text = missingShareText(
-        received, missing, "images",
-        "the subscriber queue overflowed: tracking is slower than the stream, e.g. under CPU "
-        "load; or the driver or the network dropped them");
-    if (!missing_text.empty()) problems.add(DiagnosticStatus::WARN, "images missing", missing_text);
-    if (const long back = backwards_window_.sums().first; back >= kBackwardsFlood)
-      problems.add(DiagnosticStatus::WARN, "time",
-                   "time went backwards " + std::to_string(back) +
-                       " times in the last 10 s, tracking starting over each time: two "
-                       "publishers on one image topic, or two /clock sources?");
+    for (const auto& [key, text] : stream_health_.problems(
+             "images",
+             "the subscriber queue overflowed: tracking is slower than the stream, e.g. under "
+             "CPU load; or the driver or the network dropped them",
+             "tracking starting over", "image"))
+      problems.add(DiagnosticStatus::WARN, key, text);
     if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
       problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
     for (const auto& [kind, text] : problems_.recent(kRecentS))
@@ -323,10 +316,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
   std::vector<std::string> config_errors_;  // parameters refused at start (set in init)
-  WindowCounts stream_window_;     // images received, images found missing (last 10 s)
-  WindowCounts backwards_window_;  // times the stamps went back (last 10 s)
-  // A bag loop goes back once; this many times in 10 s is a flood (two sources).
-  static constexpr long kBackwardsFlood = 3;
+  StreamHealth stream_health_;  // images missing, time going back (last 10 s)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
   static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images

@@ -391,6 +391,25 @@ TEST(WindowCounts, AMissingShareOverATenthIsAProblem) {
   EXPECT_EQ(missingShareText(0, 3, "tracks", "why"), "3 of 3 tracks missing in the last 10 s (why)");
 }
 
+TEST(StreamHealth, MissingShareAndAFloodOfTimeJumps) {
+  StreamHealth health;
+  for (int k = 0; k < 20; ++k) health.received(k % 4 == 0 ? 1 : 0);  // 5 of 25 missing
+  health.wentBackwards();
+  health.wentBackwards();  // two loops: no flood
+  auto problems = health.problems("images", "why", "tracking starting over", "image");
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].first, "images missing");
+  EXPECT_EQ(problems[0].second, "5 of 25 images missing in the last 10 s (why)");
+  health.wentBackwards();
+  problems = health.problems("images", "why", "tracking starting over", "image");
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[1].first, "time");
+  EXPECT_EQ(problems[1].second,
+            "time went backwards 3 times in the last 10 s, tracking starting over each time: "
+            "two publishers on one image topic, or two /clock sources?");
+  EXPECT_TRUE(StreamHealth().problems("tracks", "", "", "tracks").empty());
+}
+
 TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
   using Recent = std::vector<std::pair<std::string, std::string>>;
   RecentEvents events;

@@ -18,7 +18,34 @@ TEST(GapCounter, RegularStreamHasNoGaps) {
   EXPECT_EQ(gaps.add(4 * kHz30), 3);
 }
 
-TEST(GapCounter, PeriodIsTheSecondSmallestInterval) {
+// A camera stamped on arrival: +-5 ms of jitter at 30 Hz (intervals 23-43 ms) is no
+// missing image (the second smallest interval as the period counted 86 of 600); dropped
+// images are still counted.
+TEST(GapCounter, JitteryStampsAreNoGaps) {
+  auto stamp = [](int k) {  // deterministic jitter in [-5, 5] ms
+    const int64_t jitter = static_cast<int64_t>((k * 7919) % 11) - 5;
+    return k * kHz30 + jitter * 1000000;
+  };
+  GapCounter gaps;
+  long missing = 0;
+  for (int k = 1; k < 600; ++k) missing += gaps.add(stamp(k) - stamp(k - 1));
+  EXPECT_EQ(missing, 0);
+  EXPECT_NEAR(static_cast<double>(gaps.periodNs()), kHz30, 3e6);
+  GapCounter dropping;  // every 7th image lost
+  missing = 0;
+  int previous = 0, dropped = 0;
+  for (int k = 1; k < 600; ++k) {
+    if (k % 7 == 0) {
+      ++dropped;
+      continue;
+    }
+    missing += dropping.add(stamp(k) - stamp(previous));
+    previous = k;
+  }
+  EXPECT_EQ(missing, dropped);
+}
+
+TEST(GapCounter, PeriodStartsFromTheSecondSmallestInterval) {
   GapCounter gaps;
   EXPECT_EQ(gaps.periodNs(), 0);
   gaps.add(kHz30);

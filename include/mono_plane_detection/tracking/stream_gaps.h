@@ -8,8 +8,9 @@
 
 namespace mono_plane_detection {
 
-// Counts images missing from a stream by its stamps: the stream's period is the second
-// smallest of the last 64 intervals (images that came in a row), and an interval of k
+// Counts images missing from a stream by its stamps: the stream's period is the median of
+// the last 64 intervals within half a period of it (starting from the second smallest:
+// images that came in a row; jittery stamps spread those), and an interval of k
 // periods (rounded, above 1.5) means k - 1 images never reached us: our subscriber queue
 // dropped them, or the driver did. When the period estimate falls, the remembered
 // intervals are counted again (a saturated tracker sees images in a row only when its
@@ -31,8 +32,8 @@ class GapCounter {
   void addPause(int64_t interval_ns);
   void reset() { recent_.clear(); }
 
-  // The stream's period: the second smallest remembered interval (the middle one of
-  // three); 0 before three intervals.
+  // The stream's period: the median of the remembered intervals within half a period of
+  // it, from the second smallest on; 0 before three intervals.
   int64_t periodNs() const;
   // An interval after which tracking starts over: longer than max_gap_s and, once the
   // period is known, than kPausePeriods periods; before it is known (the stream's first
