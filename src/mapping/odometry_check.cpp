@@ -27,8 +27,7 @@ OdometryCheck checkOdometryMotion(const std::vector<cv::Point2d>& ref,
   cv::Mat R, t;
   const int in_front =
       cv::recoverPose(E.rowRange(0, 3), ref, cur, cv::Mat::eye(3, 3, CV_64F), R, t, mask);
-  if (in_front < params.min_tracks / 2) return out;
-  out.decided = true;
+  if (in_front < params.min_in_front_share * out.tracks) return out;
   const cv::Matx33d vision_R(R);
   // RANSAC's, not refined: 5.7 deg and 0.5 deg off on the wheeled path's pair at 0.2 px
   // of noise (refitting the direction over every inlier gave 5.3), far inside the bounds.
@@ -39,17 +38,27 @@ OdometryCheck checkOdometryMotion(const std::vector<cv::Point2d>& ref,
     out.direction_error_deg = 180;  // the images show translation, the odometry none
   } else {
     const double c = cur_from_ref.t.dot(vision_t) / (odometry_length * cv::norm(vision_t));
+    if (!std::isfinite(c)) return out;  // (a non-finite odometry: undecided, not "agrees")
     out.direction_error_deg = std::acos(std::max(-1.0, std::min(1.0, c))) * 180.0 / CV_PI;
   }
+  if (!std::isfinite(out.rotation_error_deg)) return out;
+  out.decided = true;
   out.agrees = out.direction_error_deg <= params.max_direction_deg &&
                out.rotation_error_deg <= params.max_rotation_deg;
   return out;
 }
 
 void OdometryMonitor::add(const OdometryCheck& check) {
+  tick(check.stamp);
   if (!check.decided) return;
   checks_.push_back(check);
   while (checks_.size() > static_cast<size_t>(std::max(1, params_.window))) checks_.pop_front();
+}
+
+void OdometryMonitor::tick(double stamp) {
+  if (!checks_.empty() && stamp < checks_.back().stamp) checks_.clear();  // time went back
+  while (!checks_.empty() && stamp - checks_.front().stamp > params_.max_age_s)
+    checks_.pop_front();
 }
 
 bool OdometryMonitor::disagrees() const {

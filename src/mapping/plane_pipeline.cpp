@@ -21,6 +21,9 @@ constexpr double kUprightCameraMaxDeg = 45.0;
 // wrong in every image, so a check every sixth of a second at 30 Hz finds it within 2 s.
 constexpr long kOdometryCheckEvery = 5;
 
+// (Below.) The median image motion the best rotation between two images leaves.
+double rotationFreeParallax(const std::vector<cv::Vec3d>& a, const std::vector<cv::Vec3d>& b);
+
 double jaccard(const std::vector<std::uint64_t>& a, const std::vector<std::uint64_t>& b) {
   const std::unordered_set<std::uint64_t> in_a(a.begin(), a.end());
   size_t both = 0;
@@ -136,8 +139,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     if (index < 0) {
       result.pure_rotation = true;
     } else {
-      const PastFrame& past = history_[static_cast<size_t>(index)];
-      const TrackFrame& reference = past.frame;
+      const TrackFrame& reference = history_[static_cast<size_t>(index)].frame;
       result.reference_stamp = reference.stamp;
       result.pairs = matchById(reference, frame);
       if (result.pairs.ids.size() >= 5) {
@@ -152,28 +154,38 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
         }
       }
       // The odometry's motion against the tracks' (odometry_check.h), every
-      // kOdometryCheckEvery images (0.5 ms a check): said, not acted on. Only where the
+      // kOdometryCheckEvery images (0.5-0.8 ms a check): said, not acted on. Only where the
       // tracks determine the motion: planes other than the largest hold min_plane_support
-      // of them (the tracks of one wall leave its direction two-fold ambiguous).
+      // of them (the tracks of one wall leave its direction two-fold ambiguous). Against
+      // the oldest image within reach placed by odometry: the most parallax.
       long off_largest = 0;
       for (int label : result.segmentation.labels) off_largest += label >= 2;
       if (off_largest >= params_.planes.min_plane_support && result.pose &&
-          result.pose->source == PoseSource::kOdometry && past.odometry &&
-          past.map_from_camera && past.normalized.size() == reference.ids.size() &&
+          result.pose->source == PoseSource::kOdometry &&
           image_count_ % kOdometryCheckEvery == 0) {
         std::unordered_map<std::uint64_t, size_t> now;
         for (size_t i = 0; i < frame.ids.size(); ++i) now.emplace(frame.ids[i], i);
-        std::vector<cv::Point2d> a, b;
-        for (size_t i = 0; i < reference.ids.size(); ++i) {
-          const auto it = now.find(reference.ids[i]);
-          if (it == now.end()) continue;
-          a.push_back(past.normalized[i]);
-          b.push_back(normalized[it->second]);
+        for (const PastFrame& old : history_) {
+          if (!old.odometry || !old.map_from_camera ||
+              old.normalized.size() != old.frame.ids.size())
+            continue;
+          std::vector<cv::Point2d> a, b;
+          std::vector<cv::Vec3d> ra, rb;
+          for (size_t i = 0; i < old.frame.ids.size(); ++i) {
+            const auto it = now.find(old.frame.ids[i]);
+            if (it == now.end()) continue;
+            a.push_back(old.normalized[i]);
+            b.push_back(normalized[it->second]);
+            ra.emplace_back(a.back().x, a.back().y, 1.0);
+            rb.emplace_back(b.back().x, b.back().y, 1.0);
+          }
+          if (static_cast<int>(a.size()) < OdometryCheckParams().min_tracks) continue;
+          const double focal = 0.5 * (K_(0, 0) + K_(1, 1));
+          result.odometry_check = checkOdometryMotion(
+              a, b, result.pose->map_from_camera.inverse() * *old.map_from_camera,
+              focal * rotationFreeParallax(ra, rb), result.segmentation.noise_px, focal);
+          break;
         }
-        result.odometry_check = checkOdometryMotion(
-            a, b, result.pose->map_from_camera.inverse() * *past.map_from_camera,
-            result.parallax_px, result.segmentation.noise_px, 0.5 * (K_(0, 0) + K_(1, 1)));
-        odometry_monitor_.add(result.odometry_check);
       }
     }
   }
@@ -231,6 +243,8 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
 
+  result.odometry_check.stamp = frame.stamp;
+  odometry_monitor_.add(result.odometry_check);  // (undecided: only its stamp counts)
   history_.push_back({frame, pose, std::move(normalized),
                       result.pose && result.pose->source == PoseSource::kOdometry});
   const int keep = std::max({1, params_.frame_gap, params_.max_keyframe_age});

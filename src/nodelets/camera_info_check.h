@@ -17,6 +17,10 @@
 
 namespace mono_plane_detection {
 
+// Images or tracks may come this long (wall time, s) before a usable camera_info without a
+// WARN: drivers and bags send it with the first images, not always before them.
+constexpr double kCameraInfoGraceS = 5.0;
+
 // Empty when usable, else one sentence naming the bad field and value.
 std::string cameraInfoError(const sensor_msgs::CameraInfo& info);
 

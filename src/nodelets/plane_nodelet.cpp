@@ -487,13 +487,14 @@ class PlaneNodelet : public nodelet::Nodelet {
   // ("parent -> child"), "" when none is found: with a head on joints, joint states that
   // stopped hold the images back as odometry that stopped would.
   std::string staleLink(const std::string& camera, const ros::Time& stamp) const {
-    std::string frame = camera, parent;
+    std::string frame = camera, parent, stale;
     for (int depth = 0; depth < 64 && frame != odom_frame_; ++depth) {
-      if (!tf_buffer_->_getParent(frame, ros::Time(0), parent)) return {};
-      if (!tf_buffer_->canTransform(parent, frame, stamp)) return parent + " -> " + frame;
+      if (!tf_buffer_->_getParent(frame, ros::Time(0), parent)) break;
+      if (!tf_buffer_->canTransform(parent, frame, stamp))
+        stale += (stale.empty() ? "" : ", ") + parent + " -> " + frame;
       frame = parent;
     }
-    return {};
+    return stale;
   }
 
   // odom_frame reached from the camera by static links only (/tf_static: a URDF's mount,
@@ -911,9 +912,10 @@ class PlaneNodelet : public nodelet::Nodelet {
                                                                    : "the map or the target");
       // One line per change of the status (the pose's source too: "tracking (target)" ->
       // "(odometry)" went unsaid), not of its "; too little parallax (...)" remark.
+      // A status that flips image by image is said once per 10 s each way.
       const std::string status_key = result.status.substr(0, result.status.find(';'));
       if (result.state != last_state_ || status_key != last_status_key_) {
-        NODELET_INFO("%s", result.status.c_str());
+        if (logNow("status " + status_key, 10.0)) NODELET_INFO("%s", result.status.c_str());
         last_state_ = result.state;
         last_status_key_ = status_key;
       }
@@ -1014,7 +1016,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     else if (pipeline_->odometryMonitor().disagrees())
       problems.add(DiagnosticStatus::ERROR, "odometry", odometryMismatchText());
     else if (odometry_stopped_ && !odom_stale_link_.empty() &&
-             odom_stale_link_.rfind(odom_frame_ + " -> ", 0) != 0)
+             odom_stale_link_.find(odom_frame_ + " -> ") == std::string::npos)
       // Not the odometry's own link: another publisher between it and the camera.
       problems.add(DiagnosticStatus::WARN, "odometry",
                    "tf " + odom_stale_link_ + " (between the camera and odom_frame '" +
@@ -1145,7 +1147,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
   std::string last_status_key_;  // the status last logged, without its "; ..." remark
-  static constexpr double kCameraInfoGraceS = 5.0;  // as the tracker's
   GapCounter tracks_gaps_;         // the tracks stream's rhythm (countMissingTracks)
   uint64_t last_tracks_ns_ = 0;
   long missing_tracks_ = 0;        // tracks missing from the stream, total

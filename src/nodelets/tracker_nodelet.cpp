@@ -319,7 +319,6 @@ class TrackerNodelet : public nodelet::Nodelet {
   StreamHealth stream_health_;  // images missing, time going back (last 10 s)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
-  static constexpr double kCameraInfoGraceS = 5.0;  // drivers send it with the first images
 
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // front_ and the log throttles

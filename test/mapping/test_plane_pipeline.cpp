@@ -486,32 +486,39 @@ TEST(PlanePipeline, WithKnownPosesPlanesAreMappedBeforeTheirLandmarks) {
 // it: base_link through a head's joints, a hostile try) disagrees, and the monitor says so.
 TEST(PlanePipeline, OdometryThatDoesNotMoveTheCameraAsItsImagesShowIsFound) {
   const SyntheticTracks world("wheeled");
-  auto run = [&](bool travel, int& decided, int& disagreeing) {
+  // first_alarm: the first image at which the monitor disagreed, -1 none.
+  auto run = [&](bool travel, int& decided, int& disagreeing, int& first_alarm) {
     PipelineParams params;
     params.pose.metric_source = "odometry";
     PlanePipeline pipeline(params);
     pipeline.setCamera(world.camera.K(), world.camera.distortion());
     decided = disagreeing = 0;
-    for (int k = 0; k < 200; ++k) {  // the alarm came at image 150 (7 of 10 checks)
+    first_alarm = -1;
+    for (int k = 0; k < 240; ++k) {
       const double t = k / 30.0;
       Pose odometry = world.truthMapFromCamera(t);
       if (!travel) odometry.t = world.truthMapFromCamera(0).t;  // turns, never moves
       const PipelineResult r = pipeline.process(world.frame(t), odometry);
       decided += r.odometry_check.decided;
       disagreeing += r.odometry_check.decided && !r.odometry_check.agrees;
+      if (first_alarm < 0 && pipeline.odometryMonitor().disagrees()) first_alarm = k;
     }
     return pipeline.odometryMonitor().summary();
   };
-  int decided = 0, disagreeing = 0;
-  EXPECT_EQ(run(true, decided, disagreeing), "");
+  int decided = 0, disagreeing = 0, first_alarm = -1;
+  EXPECT_EQ(run(true, decided, disagreeing, first_alarm), "");
   std::printf("true odometry: %d of %d checks disagree\n", disagreeing, decided);
-  // One image in 5 is checked, where planes other than the largest hold 8 tracks.
-  EXPECT_GE(decided, 10);
-  EXPECT_EQ(disagreeing, 0);
-  const std::string said = run(false, decided, disagreeing);
-  std::printf("odometry without travel: %d of %d checks disagree: %s\n", disagreeing, decided,
-              said.c_str());
-  EXPECT_GE(decided, 10);
+  // One image in 5 is checked, where planes other than the largest hold 8 tracks; a
+  // single check may fail (measured 1 of 26: a wrong essential matrix from 36 tracks),
+  // the monitor never (7 of 10).
+  EXPECT_GE(decided, 15);
+  EXPECT_LE(disagreeing, decided / 5);
+  EXPECT_EQ(first_alarm, -1);
+  const std::string said = run(false, decided, disagreeing, first_alarm);
+  std::printf("odometry without travel: %d of %d checks disagree, alarm at image %d: %s\n",
+              disagreeing, decided, first_alarm, said.c_str());
+  EXPECT_GE(decided, 15);
   EXPECT_GE(disagreeing, decided * 9 / 10);
+  EXPECT_GE(first_alarm, 0);
   EXPECT_EQ(said.rfind("its translation ", 0), 0u) << said;
 }

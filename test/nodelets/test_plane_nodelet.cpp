@@ -449,8 +449,11 @@ TEST_F(PlaneNodeletTest, H_WithoutCameraInfoThePlanesStayInTheImage) {
   // Its diagnostics say so, once camera_info's grace (5 s of tracks) is over (the tests
   // before ran longer); the first tracks of a bag often come before camera_info.
   DiagnosticsProbe diagnostics(nh_, "plane_detector_no_info: planes");
-  ASSERT_TRUE(diagnostics.waitFresh());
-  EXPECT_EQ(diagnostics.value("problem: camera_info"), "WARN: tracks arrive but no usable camera_info");
+  const std::string warn = "WARN: tracks arrive but no usable camera_info";
+  // (Alone this test starts within the grace: wait for it to end, up to 8 s.)
+  for (int k = 0; k < 8 && diagnostics.value("problem: camera_info") != warn; ++k)
+    ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("problem: camera_info"), warn);
 }
 
 // The robot's odometry: tf odom -> camera_optical for every image (the true pose seen
@@ -469,7 +472,8 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
       "/rosout", 200, [&](const rosgraph_msgs::LogConstPtr& m) {
         if (m->level == rosgraph_msgs::Log::INFO) logged.push_back(m->msg);
       });
-  ASSERT_TRUE(spinUntil([&] { return rosout.getNumPublishers() > 0; }, 10.0));
+  // The manager's publisher besides this node's own.
+  ASSERT_TRUE(spinUntil([&] { return rosout.getNumPublishers() >= 2; }, 10.0));
   ros::WallDuration(0.3).sleep();
   const Pose odom_from_map{cameraOrientation(0.3, 0, 0), {1, 0, 0}};
   PlaneArrayConstPtr last;

@@ -24,16 +24,24 @@ struct OdometryCheckParams {
   double max_direction_deg = 45.0;
   // The rotations apart beyond this (deg) disagree (a wrong frame turns the axes).
   double max_rotation_deg = 10.0;
-  int min_tracks = 20;           // fewer shared tracks: not decided (and no noise scale)
-  double min_parallax_px = 12.0;  // less rotation-free parallax: not decided (a turn
-                                  // on the spot fits any translation)
+  int min_tracks = 20;  // fewer shared tracks: not decided (and no noise scale)
+  // Less rotation-free parallax: not decided (a turn on the spot fits any translation).
+  // Twice the planes' keyframe parallax: at 12 px single checks of the true humanoid
+  // odometry reached 54 deg at 1 px of track noise (a review); the pipeline takes the
+  // oldest image within reach for the check.
+  double min_parallax_px = 24.0;
+  // Fewer of the tracks in front of both cameras under the tracks' motion: not decided
+  // (moving things or mismatches may hold the motion RANSAC found).
+  double min_in_front_share = 0.6;
   // OdometryMonitor: of the last `window` decided checks, this many disagreeing make
   // the disagreement persistent (one bad pair is not a configuration error).
   int window = 10;
   int min_disagreeing = 7;
+  double max_age_s = 10.0;  // checks older than this (image stamps) are forgotten
 };
 
 struct OdometryCheck {
+  double stamp = 0;      // the current image's (s)
   bool decided = false;  // enough shared tracks and parallax to tell
   bool agrees = true;
   int tracks = 0;
@@ -62,7 +70,10 @@ class OdometryMonitor {
   explicit OdometryMonitor(const OdometryCheckParams& params = OdometryCheckParams())
       : params_(params) {}
   void add(const OdometryCheck& check);
-  // min_disagreeing of the last `window` decided checks disagree.
+  // The newest image's stamp: checks max_age_s older are forgotten (a robot that stands
+  // still decides no more checks; an old disagreement must not stay for ever).
+  void tick(double stamp);
+  // min_disagreeing of the last `window` decided checks (within max_age_s) disagree.
   bool disagrees() const;
   // For people: "the translation 88 deg off (median), rotation 0.4 deg, in 9 of the last
   // 10 image pairs"; "" while it agrees.
