@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
-
 #include <opencv2/calib3d.hpp>
+#include <sstream>
 
 namespace mono_plane_detection {
 
@@ -57,8 +56,7 @@ void OdometryMonitor::add(const OdometryCheck& check) {
 
 void OdometryMonitor::tick(double stamp) {
   if (!checks_.empty() && stamp < checks_.back().stamp) checks_.clear();  // time went back
-  while (!checks_.empty() && stamp - checks_.front().stamp > params_.max_age_s)
-    checks_.pop_front();
+  while (!checks_.empty() && stamp - checks_.front().stamp > params_.max_age_s) checks_.pop_front();
 }
 
 bool OdometryMonitor::disagrees() const {

@@ -52,7 +52,8 @@ cv::Matx33d about(const cv::Vec3d& axis, double deg) {
 TEST(OdometryCheck, TheTrueMotionAgrees) {
   const TrackPair pair = wheeledPair(2.0, 2.5);
   ASSERT_GE(pair.ref.size(), 40u);
-  const OdometryCheck check = checkOdometryMotion(pair.ref, pair.cur, pair.cur_from_ref, 30.0, kNoise, kFocal);
+  const OdometryCheck check =
+      checkOdometryMotion(pair.ref, pair.cur, pair.cur_from_ref, 30.0, kNoise, kFocal);
   ASSERT_TRUE(check.decided);
   EXPECT_TRUE(check.agrees);
   std::printf("true motion: translation %.2f deg, rotation %.2f deg off\n",
@@ -69,7 +70,8 @@ TEST(OdometryCheck, OdometryWithARobotsErrorsAgrees) {
   Pose odometry = pair.cur_from_ref;
   odometry.t = 1.1 * (about({0, 1, 0}, 8.0) * odometry.t);
   odometry.R = about({0, 1, 0}, 1.0) * odometry.R;
-  const OdometryCheck check = checkOdometryMotion(pair.ref, pair.cur, odometry, 30.0, kNoise, kFocal);
+  const OdometryCheck check =
+      checkOdometryMotion(pair.ref, pair.cur, odometry, 30.0, kNoise, kFocal);
   ASSERT_TRUE(check.decided);
   EXPECT_TRUE(check.agrees) << check.direction_error_deg << " / " << check.rotation_error_deg;
 }
@@ -109,12 +111,15 @@ TEST(OdometryCheck, TooFewTracksOrTooLittleParallaxIsNotDecided) {
   const TrackPair pair = wheeledPair(2.0, 2.5);
   Pose still = pair.cur_from_ref;
   still.t = cv::Vec3d(0, 0, 0);
-  EXPECT_FALSE(checkOdometryMotion(pair.ref, pair.cur, still, 20.0, kNoise, kFocal).decided);  // under 24 px
+  EXPECT_FALSE(
+      checkOdometryMotion(pair.ref, pair.cur, still, 20.0, kNoise, kFocal).decided);  // under 24 px
   const std::vector<cv::Point2d> few_ref(pair.ref.begin(), pair.ref.begin() + 15),
       few_cur(pair.cur.begin(), pair.cur.begin() + 15);
   EXPECT_FALSE(checkOdometryMotion(few_ref, few_cur, still, 30.0, kNoise, kFocal).decided);
-  EXPECT_FALSE(checkOdometryMotion(pair.ref, few_cur, still, 30.0, kNoise, kFocal).decided);  // sizes differ
-  EXPECT_FALSE(checkOdometryMotion(pair.ref, pair.cur, still, 30.0, 0.0, kFocal).decided);  // no scale
+  EXPECT_FALSE(
+      checkOdometryMotion(pair.ref, few_cur, still, 30.0, kNoise, kFocal).decided);  // sizes differ
+  EXPECT_FALSE(
+      checkOdometryMotion(pair.ref, pair.cur, still, 30.0, 0.0, kFocal).decided);  // no scale
 }
 
 TEST(OdometryMonitor, APersistentDisagreementOnly) {

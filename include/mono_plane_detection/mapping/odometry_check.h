@@ -9,10 +9,9 @@
 
 #include <cstddef>
 #include <deque>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "mono_plane_detection/geometry/pose.h"
 
