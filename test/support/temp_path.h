@@ -49,9 +49,12 @@ class TestTempFolder {
 inline std::string tempPath(const std::string& name) {
   static std::mutex mutex;
   static std::unique_ptr<TestTempFolder> folder;  // removed at exit by its own process only
+  // A forked child's copy of its parent's folder, kept until its exit, whose destructor
+  // leaves the folder alone (released into nothing, LeakSanitizer failed the child).
+  static std::unique_ptr<TestTempFolder> inherited;
   std::lock_guard<std::mutex> lock(mutex);
   if (!folder || !folder->ownedByThisProcess()) {
-    (void)folder.release();  // a forked child's copy of its parent's folder: left alone
+    if (folder) inherited = std::move(folder);
     folder = std::make_unique<TestTempFolder>();
   }
   return folder->path() + "/" + name;
