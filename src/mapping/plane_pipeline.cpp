@@ -120,7 +120,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       result.tracking_loss = true;
       result.pause_s = since;
     } else {
-      stream_.add(since_ns);
+      result.missing_images = stream_.add(since_ns);
     }
   }
 

@@ -35,7 +35,6 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
-#include "mono_plane_detection/tracking/stream_gaps.h"
 #include "mono_plane_detection/viz/draw_planes.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
@@ -365,25 +364,6 @@ class PlaneNodelet : public nodelet::Nodelet {
            "right, y down)?";
   }
 
-  // Tracks missing from the stream by their stamps (mutex_ held): the tracker's images it
-  // never got and tracks this nodelet's queue dropped; roscpp reports neither.
-  void countMissingTracks(const ros::Time& stamp) {
-    const uint64_t ns = stamp.toNSec();
-    long missing = 0;
-    if (last_tracks_ns_ != 0 && ns > last_tracks_ns_) {
-      const auto interval = static_cast<int64_t>(ns - last_tracks_ns_);
-      if (tracks_gaps_.isPause(interval, params_.max_gap_s))
-        tracks_gaps_.addPause(interval);
-      else
-        missing = tracks_gaps_.add(interval);
-    } else if (ns < last_tracks_ns_) {
-      tracks_gaps_.reset();  // time went back: a new stream
-    }
-    last_tracks_ns_ = ns;
-    missing_tracks_ += missing;
-    stream_health_.received(missing);
-  }
-
   // Tracks for kCameraInfoGraceS of wall time without a usable camera_info: the first
   // tracks of a bag or a driver often come before it (a WARN at every start before).
   bool cameraInfoOverdue() const {
@@ -487,14 +467,21 @@ class PlaneNodelet : public nodelet::Nodelet {
   // ("parent -> child"), "" when none is found: with a head on joints, joint states that
   // stopped hold the images back as odometry that stopped would.
   std::string staleLink(const std::string& camera, const ros::Time& stamp) const {
-    std::string frame = camera, parent, stale;
-    for (int depth = 0; depth < 64 && frame != odom_frame_; ++depth) {
-      if (!tf_buffer_->_getParent(frame, ros::Time(0), parent)) break;
-      if (!tf_buffer_->canTransform(parent, frame, stamp))
-        stale += (stale.empty() ? "" : ", ") + parent + " -> " + frame;
-      frame = parent;
-    }
+    const std::vector<std::string> chain = tfAncestors(camera);
+    std::string stale;
+    for (size_t k = 0; k + 1 < chain.size() && chain[k] != odom_frame_; ++k)
+      if (!tf_buffer_->canTransform(chain[k + 1], chain[k], stamp))
+        stale += (stale.empty() ? "" : ", ") + chain[k + 1] + " -> " + chain[k];
     return stale;
+  }
+
+  // frame, its parent on tf (latest), that one's, ... up to the root (at most 64).
+  std::vector<std::string> tfAncestors(const std::string& frame) const {
+    std::vector<std::string> chain{frame};
+    std::string parent;
+    while (chain.size() < 64 && tf_buffer_->_getParent(chain.back(), ros::Time(0), parent))
+      chain.push_back(parent);
+    return chain;
   }
 
   // odom_frame reached from the camera by static links only (/tf_static: a URDF's mount,
@@ -536,11 +523,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0))) {
       // Where the camera's chain ends: a URDF frame whose joint's publisher has not sent
       // yet (robot_state_publisher at start) is no wrong frame_id.
-      std::string top = camera, parent;
-      for (int depth = 0; depth < 64 && tf_buffer_->_getParent(top, ros::Time(0), parent); ++depth)
-        top = parent;
       return "camera frame '" + camera + "' (the images' header.frame_id) is not connected to " +
-             "odom_frame '" + odom_frame_ + "' on tf (yet): its tf goes up to '" + top +
+             "odom_frame '" + odom_frame_ + "' on tf (yet): its tf goes up to '" +
+             tfAncestors(camera).back() +
              "' only; the link above that is missing (its publisher not running yet, e.g. "
              "robot_state_publisher, or the odometry's odom -> base_link), or the frame_id is "
              "not a frame of the robot's URDF";
@@ -929,7 +914,10 @@ class PlaneNodelet : public nodelet::Nodelet {
         target_wait_.reset();
       }
       ++frames_;
-      countMissingTracks(msg.header.stamp);
+      // Tracks missing by their stamps, as the pipeline's rhythm counts them: the tracker's
+      // images it never got and tracks this nodelet's queue dropped (roscpp says neither).
+      missing_tracks_ += result.missing_images;
+      stream_health_.received(result.missing_images);
       status_ = result.status;
       state_ = result.state;
       observed_ = result.planes.size();
@@ -1147,8 +1135,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
   std::string last_status_key_;  // the status last logged, without its "; ..." remark
-  GapCounter tracks_gaps_;         // the tracks stream's rhythm (countMissingTracks)
-  uint64_t last_tracks_ns_ = 0;
   long missing_tracks_ = 0;        // tracks missing from the stream, total
   StreamHealth stream_health_;     // tracks missing, time going back (last 10 s)
   ros::WallTime first_tracks_;  // wall time of the first tracks (camera_info's grace)

@@ -8,6 +8,7 @@
 #include <ros/time.h>
 
 #include <algorithm>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <string>
@@ -97,11 +98,11 @@ class WindowCounts {
   };
   void forget(const ros::WallTime& now) {
     while (!entries_.empty() && (now - entries_.front().at).toSec() > window_s_)
-      entries_.erase(entries_.begin());
+      entries_.pop_front();
   }
   double window_s_;
   mutable std::mutex mutex_;
-  std::vector<Entry> entries_;  // oldest first
+  std::deque<Entry> entries_;  // oldest first
 };
 
 // "N of M images missing in the last 10 s ..." when over a tenth of a stream's images

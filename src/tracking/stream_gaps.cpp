@@ -29,7 +29,6 @@ int64_t GapCounter::periodNs() const {
   for (int round = 0; round < 4; ++round) {
     const auto low = std::lower_bound(sorted.begin(), sorted.end(), period / 2);
     const auto high = std::upper_bound(sorted.begin(), sorted.end(), period + period / 2);
-    if (high - low < 1) break;
     const int64_t median = *(low + (high - low) / 2);
     if (median == period) break;
     period = median;

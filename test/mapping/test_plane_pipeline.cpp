@@ -151,6 +151,23 @@ TEST(PlanePipeline, TimeGoingBackwardsResetsAPauseIsATrackingLoss) {
   EXPECT_TRUE(pipeline.map().planes().empty());
 }
 
+// The images missing before each one, from the stamps' gaps (the plane nodelet's count of
+// tracks missing): none in a regular stream, 2 when two images of it never came, none in
+// a pause.
+TEST(PlanePipeline, MissingImagesAreCountedFromTheStampsGaps) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  long missing = 0;
+  for (int k = 0; k < 10; ++k) missing += pipeline.process(world.frame(k / 30.0)).missing_images;
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(pipeline.process(world.frame(12 / 30.0)).missing_images, 2);
+  EXPECT_EQ(pipeline.process(world.frame(13 / 30.0)).missing_images, 0);
+  const PipelineResult pause = pipeline.process(world.frame(3.0));
+  EXPECT_TRUE(pause.tracking_loss);
+  EXPECT_EQ(pause.missing_images, 0);
+}
+
 // dynamic_reconfigure's path: the per-image parameters take effect on the next image,
 // without a restart (the map and the image history are kept).
 TEST(PlanePipeline, PerImageParamsApplyToTheNextImage) {

@@ -82,6 +82,9 @@ struct PipelineResult {
   bool was_reset = false;            // time went backwards: everything started again
   bool tracking_loss = false;        // the pause since the last image exceeded max_gap_s
   double pause_s = 0;                // with tracking_loss: that pause, s
+  // Images missing from the stream just before this one, by the stamps' gaps (GapCounter):
+  // dropped by the tracker, or frames this stage's caller never got.
+  long missing_images = 0;
   std::optional<PoseEstimate> pose;  // this image's camera in the map
   std::vector<ImagePlane> planes;    // largest first
   double reference_stamp = -1;       // image the homographies start from, -1 none
