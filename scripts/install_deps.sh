@@ -5,7 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake catkin
-  ros-message-generation ros-message-runtime libroscpp-dev
+  ros-message-generation ros-message-runtime libroscpp-dev libroslib-dev
   libnodeletlib-dev libnodeletlib-tools
   libimage-transport-dev image-transport-tools libcv-bridge-dev
   libdiagnostic-updater-dev ros-diagnostic-msgs python3-diagnostic-msgs

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "config_dir.h"
 #include "profile.h"
 #include "mono_plane_detection/tracking/marker_target.h"
 #include "mono_plane_detection/tracking/target_detector.h"
@@ -37,7 +38,7 @@ std::string jsonString(const std::string& s) {
 
 int main(int argc, char** argv) {
   auto profile =
-      readToolProfile(argc, argv, MPD_CONFIG_DIR, "tracker", trackerNodeParamTable(), std::string("default"));
+      readToolProfile(argc, argv, toolConfigDir(MPD_CONFIG_DIR), "tracker", trackerNodeParamTable(), std::string("default"));
   TargetParams params = profile.params.target;
   std::vector<std::string> images;
   bool json = false;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli_args.h"
+#include "config_dir.h"
 #include "profile.h"
 #include "mono_plane_detection/planes/homography_voting.h"
 
@@ -44,7 +45,7 @@ cv::Ptr<cv::Feature2D> detector(const std::string& name, int features) {
 
 int main(int argc, char** argv) {
   auto profile =
-      readToolProfile(argc, argv, MPD_CONFIG_DIR, "planes", planeNodeParamTable(), std::string("none"));
+      readToolProfile(argc, argv, toolConfigDir(MPD_CONFIG_DIR), "planes", planeNodeParamTable(), std::string("none"));
   PlaneParams params = profile.params.pipeline.planes;
   Intrinsics in1, in2;
   std::string img1, img2, overlay = "plane_pair.png", features = "sift", matches_file;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "cli_args.h"
+#include "config_dir.h"
 #include "profile.h"
 #include "mono_plane_detection/sim/camera_trajectory.h"
 #include "mono_plane_detection/eval/map_evaluation.h"
@@ -140,7 +141,7 @@ int main(int argc, char** argv) {
   TrackerNodeParams tracker_node;
   PlaneNodeParams plane_node;
   const std::vector<std::string> errors =
-      loadProfiles(MPD_CONFIG_DIR, profile, "tracker", trackerNodeParamTable(), tracker_node,
+      loadProfiles(toolConfigDir(MPD_CONFIG_DIR), profile, "tracker", trackerNodeParamTable(), tracker_node,
                    "planes", planeNodeParamTable(), plane_node);
   if (!errors.empty()) {
     for (const std::string& e : errors) std::fprintf(stderr, "run_pipeline: %s\n", e.c_str());

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_args.h"
+#include "config_dir.h"
 #include "profile.h"
 #include "mono_plane_detection/planes/correspondence_io.h"
 #include "mono_plane_detection/planes/homography_voting.h"
@@ -43,7 +44,7 @@ void printJson(const PlaneSegmentation& result, size_t points) {
 
 int main(int argc, char** argv) {
   auto profile =
-      readToolProfile(argc, argv, MPD_CONFIG_DIR, "planes", planeNodeParamTable(), std::string("none"));
+      readToolProfile(argc, argv, toolConfigDir(MPD_CONFIG_DIR), "planes", planeNodeParamTable(), std::string("none"));
   PlaneParams params = profile.params.pipeline.planes;
   bool json = false;
   std::string path;

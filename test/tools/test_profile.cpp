@@ -4,8 +4,11 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
+#include "../../src/tools/config_dir.h"
 #include "../../src/tools/profile.h"
 #include "support/temp_path.h"
 
@@ -23,9 +26,9 @@ std::string writeYaml(const std::string& name, const std::string& text) {
 
 TEST(Profile, NestedKeysSetTheirFields) {
   PlaneNodeParams p;
-  const std::string path =
-      writeYaml("nested.yaml", "frame_gap: 7\nplanes:\n  vote_threshold_px: 3.5\n  groups:\n"
-                               "    max_groups: 42\npublish_tf: false\nmap_frame: world\n");
+  const std::string path = writeYaml("nested.yaml",
+                                     "frame_gap: 7\nplanes:\n  vote_threshold_px: 3.5\n  groups:\n"
+                                     "    max_groups: 42\npublish_tf: false\nmap_frame: world\n");
   EXPECT_TRUE(applyYamlFile(path, planeNodeParamTable(), p).empty());
   EXPECT_EQ(p.pipeline.frame_gap, 7);
   EXPECT_DOUBLE_EQ(p.pipeline.planes.vote_threshold_px, 3.5);
@@ -37,9 +40,10 @@ TEST(Profile, NestedKeysSetTheirFields) {
 TEST(Profile, BadValuesAreNamedAndTheDefaultKept) {
   const PlaneNodeParams defaults;
   PlaneNodeParams p;
-  const std::string path = writeYaml(
-      "bad.yaml", "frame_gap: 2.5\nplanes:\n  max_planes: many\n  vote_threshold_px: -1\n"
-                  "no_such_thing: 1\npublish_tf: maybe\n");
+  const std::string path =
+      writeYaml("bad.yaml",
+                "frame_gap: 2.5\nplanes:\n  max_planes: many\n  vote_threshold_px: -1\n"
+                "no_such_thing: 1\npublish_tf: maybe\n");
   const std::vector<std::string> errors = applyYamlFile(path, planeNodeParamTable(), p);
   ASSERT_EQ(errors.size(), 5u);
   std::string all;
@@ -58,8 +62,8 @@ TEST(Profile, BadValuesAreNamedAndTheDefaultKept) {
 TEST(Profile, UnreadableFileIsAnError) {
   TrackerNodeParams p;
   EXPECT_EQ(applyYamlFile("/no/such/file.yaml", trackerNodeParamTable(), p).size(), 1u);
-  EXPECT_EQ(applyYamlFile(writeYaml("broken.yaml", "a: [1, 2\n"), trackerNodeParamTable(), p).size(),
-            1u);
+  EXPECT_EQ(
+      applyYamlFile(writeYaml("broken.yaml", "a: [1, 2\n"), trackerNodeParamTable(), p).size(), 1u);
 }
 
 // Every key of config/tracker_humanoid.yaml reaches the tool, over config/tracker.yaml.
@@ -114,16 +118,16 @@ TEST(Profile, OneFileForBothNodeletsSetsEachNameWhereItIsKnown) {
   EXPECT_EQ(loadProfiles(dir, file, "tracker", trackerNodeParamTable(), tracker, "planes",
                          planeNodeParamTable(), planes),
             std::vector<std::string>());
-  EXPECT_EQ(tracker.tracker.max_features, 77);             // the tracker's name
-  EXPECT_EQ(planes.pipeline.map.min_points, 9);            // the planes' name
-  EXPECT_EQ(planes.pipeline.frame_gap, 6);                 // the base file kept
-  EXPECT_DOUBLE_EQ(tracker.target.width_m, 0.2794);        // a name both have: both
+  EXPECT_EQ(tracker.tracker.max_features, 77);       // the tracker's name
+  EXPECT_EQ(planes.pipeline.map.min_points, 9);      // the planes' name
+  EXPECT_EQ(planes.pipeline.frame_gap, 6);           // the base file kept
+  EXPECT_DOUBLE_EQ(tracker.target.width_m, 0.2794);  // a name both have: both
   EXPECT_DOUBLE_EQ(planes.pipeline.target.width_m, 0.2794);
   // A name neither has is one error naming it; a bad value of a shared name is one error.
-  const std::string bad =
-      writeYaml("bad.yaml", "max_feature: 77\ntarget:\n  width_m: fast\n");
-  const std::vector<std::string> errors = loadProfiles(
-      dir, bad, "tracker", trackerNodeParamTable(), tracker, "planes", planeNodeParamTable(), planes);
+  const std::string bad = writeYaml("bad.yaml", "max_feature: 77\ntarget:\n  width_m: fast\n");
+  const std::vector<std::string> errors =
+      loadProfiles(dir, bad, "tracker", trackerNodeParamTable(), tracker, "planes",
+                   planeNodeParamTable(), planes);
   ASSERT_EQ(errors.size(), 2u) << (errors.empty() ? std::string("none") : errors[0]);
   EXPECT_NE(errors[0].find("unknown parameter max_feature (neither tracker nor planes"),
             std::string::npos)
@@ -143,12 +147,13 @@ TEST(Profile, OneFileForBothNodeletsSetsEachNameWhereItIsKnown) {
 
 TEST(Profile, NoneKeepsTheCoreDefaultsAndUnknownProfilesAreNamed) {
   PlaneNodeParams p;
-  EXPECT_TRUE(loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "none",
-                          planeNodeParamTable(), p)
-                  .empty());
-  EXPECT_EQ(p.pipeline.planes.groups.max_groups, PlaneNodeParams().pipeline.planes.groups.max_groups);
-  const std::vector<std::string> errors = loadProfile(
-      std::string(SOURCE_DIR) + "/config", "planes", "tracked_vehicle", planeNodeParamTable(), p);
+  EXPECT_TRUE(
+      loadProfile(std::string(SOURCE_DIR) + "/config", "planes", "none", planeNodeParamTable(), p)
+          .empty());
+  EXPECT_EQ(p.pipeline.planes.groups.max_groups,
+            PlaneNodeParams().pipeline.planes.groups.max_groups);
+  const std::vector<std::string> errors = loadProfile(std::string(SOURCE_DIR) + "/config", "planes",
+                                                      "tracked_vehicle", planeNodeParamTable(), p);
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_NE(errors[0].find("no profile"), std::string::npos) << errors[0];
 }
@@ -195,4 +200,39 @@ TEST(Profile, ToolProfileReadsTheArgumentAndItsFiles) {
   EXPECT_EQ(fallback.name, "none");
   EXPECT_EQ(fallback.params.tracker.window_size_px, TrackerNodeParams().tracker.window_size_px);
   EXPECT_NE(profileHelp("planes").find("config/planes.yaml"), std::string::npos);
+}
+
+// An installed tool read its profiles from the source folder it was built from, which is
+// gone wherever the package is installed from a binary package: it failed with "bad file".
+TEST(ToolConfigDir, TheFolderRosFindsTheShareOrSourceInElseTheBuiltIn) {
+  const char* saved = std::getenv("ROS_PACKAGE_PATH");
+  const std::string saved_path = saved ? saved : "";
+  const std::string built_in = "/built/from/config";
+
+  unsetenv("ROS_PACKAGE_PATH");  // outside a ROS environment
+  EXPECT_EQ(toolConfigDir(built_in), built_in);
+
+  // An install prefix's share folder, as rospack finds it.
+  const std::string share = tempPath("share");
+  const std::string package = share + "/mono_plane_detection";
+  std::filesystem::create_directories(package);
+  std::ofstream(package + "/package.xml")
+      << "<package format=\"2\"><name>mono_plane_detection</name><version>0.0.0</version>"
+         "<description>d</description><maintainer email=\"a@b.c\">m</maintainer>"
+         "<license>BSD</license></package>\n";
+  setenv("ROS_PACKAGE_PATH", share.c_str(), 1);
+  EXPECT_EQ(toolConfigDir(built_in), built_in);  // found, but without config/
+  std::filesystem::create_directories(package + "/config");
+  EXPECT_EQ(toolConfigDir(built_in), package + "/config");
+
+  // A ROS environment that does not hold the package.
+  const std::string other = tempPath("other_share");
+  std::filesystem::create_directories(other);
+  setenv("ROS_PACKAGE_PATH", other.c_str(), 1);
+  EXPECT_EQ(toolConfigDir(built_in), built_in);
+
+  if (saved)
+    setenv("ROS_PACKAGE_PATH", saved_path.c_str(), 1);
+  else
+    unsetenv("ROS_PACKAGE_PATH");
 }

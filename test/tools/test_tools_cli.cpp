@@ -95,7 +95,11 @@ TEST(ToolsCli, DocsToolsPageIsEveryToolsHelp) {
       "Generated from each program's `--help` (its option table in `src/tools/`) by\n"
       "`MPD_WRITE_TOOLS_DOC=1 test_tools_cli`; `test_tools_cli` fails when this page is out\n"
       "of date. Run them as `rosrun mono_plane_detection PROGRAM`. Every program answers\n"
-      "`--help` with exit 0 and refuses bad usage with exit 2 and the reason.\n";
+      "`--help` with exit 0 and refuses bad usage with exit 2 and the reason.\n"
+      "A `--profile` reads `config/` where ROS finds the package, as roslaunch's `$(find\n"
+      "mono_plane_detection)` does: the share folder of an installed package (`catkin_make\n"
+      "install`, a binary package), the source folder in a devel workspace; outside a ROS\n"
+      "environment, the source folder the program was built from (`src/tools/config_dir.h`).\n";
   for (const auto& [name, path] : kTools) page += "\n## " + name + "\n\n```\n" + run(path, "--help").out + "```\n";
   const std::string doc = std::string(SOURCE_DIR) + "/docs/tools.md";
   if (std::getenv("MPD_WRITE_TOOLS_DOC")) {
