@@ -40,6 +40,7 @@
 #include "plane_messages.h"
 #include "recent_events.h"
 #include "ros_params.h"
+#include "tf_tree_view.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -110,6 +111,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     save_srv_.shutdown();
     reconfigure_.reset();
     tf_listener_.reset();
+    tf_view_.reset();
     tf_buffer_.reset();
     broadcaster_.reset();
     image_transport_.reset();
@@ -169,11 +171,12 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (publish_tf_ || !odom_frame_.empty()) {
       tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
       tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_);
+      tf_view_ = std::make_unique<TfTreeView>(*tf_buffer_);
     }
     // tf2 keeps one cache per frame: a static parent that comes after our own dynamic
     // link to the same child hides behind it there. Static links are latched, one
     // message per publisher on connecting (tf2_ros's own queue: 100): their parents are
-    // kept here for the tf check and for odom_frame's (rigidOdomFrame).
+    // kept (tf_view_) for the tf check and for odom_frame's (rigidOdomFrame).
     if (publish_tf_ || !odom_frame_.empty())
       static_sub_ = nh.subscribe<tf2_msgs::TFMessage>(
           "/tf_static", 100, guard_.message("tf_static", this, &PlaneNodelet::onTfStatic));
@@ -421,7 +424,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     stale_link.clear();
     rigid = false;
     if (odom_frame_.empty()) return {};
-    tf_problem = rigidOdomFrame(tfFrame(header.frame_id));
+    tf_problem = tf_view_->rigidOdomFrame(tfFrame(header.frame_id), odom_frame_);
     rigid = !tf_problem.empty();
     if (rigid) {
       if (logNow("odometry rigid", 10.0)) NODELET_ERROR("%s: visual pose only", tf_problem.c_str());
@@ -452,8 +455,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       return odom;
     } catch (const tf2::TransformException& e) {
-      tf_problem = odometryTfProblem(tfFrame(header.frame_id));
-      if (tf_problem.empty()) stale_link = staleLink(tfFrame(header.frame_id), header.stamp);
+      tf_problem = tf_view_->odometryProblem(tfFrame(header.frame_id), odom_frame_);
+      if (tf_problem.empty())
+        stale_link = tf_view_->staleLinks(tfFrame(header.frame_id), odom_frame_, header.stamp);
       if (!tf_problem.empty() ? logNow("odometry tf " + tf_problem, 10.0)
                               : logNow("odometry lookup", 10.0))
         NODELET_WARN("no %s -> %s transform at %.3f (%s): visual pose only%s%s",
@@ -463,141 +467,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
   }
 
-  // The first link on tf from the camera up to odom_frame that has no transform at stamp
-  // ("parent -> child"), "" when none is found: with a head on joints, joint states that
-  // stopped hold the images back as odometry that stopped would.
-  std::string staleLink(const std::string& camera, const ros::Time& stamp) const {
-    const std::vector<std::string> chain = tfAncestors(camera);
-    std::string stale;
-    for (size_t k = 0; k + 1 < chain.size() && chain[k] != odom_frame_; ++k)
-      if (!tf_buffer_->canTransform(chain[k + 1], chain[k], stamp))
-        stale += (stale.empty() ? "" : ", ") + chain[k + 1] + " -> " + chain[k];
-    return stale;
-  }
-
-  // frame, its parent on tf (latest), that one's, ... up to the root (at most 64).
-  std::vector<std::string> tfAncestors(const std::string& frame) const {
-    std::vector<std::string> chain{frame};
-    std::string parent;
-    while (chain.size() < 64 && tf_buffer_->_getParent(chain.back(), ros::Time(0), parent))
-      chain.push_back(parent);
-    return chain;
-  }
-
-  // odom_frame reached from the camera by static links only (/tf_static: a URDF's mount,
-  // e.g. odom_frame:=base_link): it moves with the camera, so its "odometry" would say the
-  // camera never moves, and plane_map -> base_link would give the robot's frame a second
-  // parent. Why, or "" when odom_frame is not such a frame.
-  std::string rigidOdomFrame(const std::string& camera) const {
-    if (camera == odom_frame_)
-      return "odom_frame '" + odom_frame_ + "' is the camera frame itself: it is no odometry; " +
-             "set odom_frame to the odometry's fixed frame (e.g. odom)";
-    std::string frame = camera;
-    for (int depth = 0; depth < 64; ++depth) {
-      const std::optional<std::string> parent = staticParent(frame);
-      if (!parent) return {};
-      frame = *parent;
-      if (frame == odom_frame_)
-        return "odom_frame '" + odom_frame_ + "' is rigidly attached to the camera frame '" +
-               camera + "' (static transforms only, /tf_static): it moves with the camera, so "
-               "it is no odometry; set odom_frame to the odometry's fixed frame (e.g. odom)";
-    }
-    return {};
-  }
-
-  // Why tf cannot link odom_frame to the camera at any time, "" when it can (then only
-  // the image's stamp is missing: odometry stopped or late). A camera frame that is not
-  // a frame of the robot's tf (a driver's frame_id against another URDF name) is not the
-  // odometry's fault.
-  std::string odometryTfProblem(const std::string& camera) const {
-    const std::string fix =
-        ": the images' header.frame_id must be a tf frame of the robot "
-        "(its URDF), linked to odom_frame '" +
-        odom_frame_ + "'";
-    if (camera.empty()) return "the images have an empty frame_id" + fix;
-    if (!tf_buffer_->_frameExists(camera))
-      return "camera frame '" + camera + "' (the images' header.frame_id) is not in the tf tree" +
-             fix;
-    if (!tf_buffer_->_frameExists(odom_frame_))
-      return "odom_frame '" + odom_frame_ + "' is not on tf: no odometry published (yet)";
-    if (!tf_buffer_->canTransform(odom_frame_, camera, ros::Time(0))) {
-      // Where the camera's chain ends: a URDF frame whose joint's publisher has not sent
-      // yet (robot_state_publisher at start) is no wrong frame_id.
-      return "camera frame '" + camera + "' (the images' header.frame_id) is not connected to " +
-             "odom_frame '" + odom_frame_ + "' on tf (yet): its tf goes up to '" +
-             tfAncestors(camera).back() +
-             "' only; the link above that is missing (its publisher not running yet, e.g. "
-             "robot_state_publisher, or the odometry's odom -> base_link), or the frame_id is "
-             "not a frame of the robot's URDF";
-    }
-    return {};
-  }
-
-  // Why publishing parent -> child would break the tf tree (REP 105), "" when it would
-  // not. tf2 keeps the latest parent of each frame: another broadcaster of `child` shows
-  // as another parent, or, before our first transform, as the same edge already there.
-  void onTfStatic(const tf2_msgs::TFMessageConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(static_mutex_);
-    for (const auto& t : msg->transforms) {
-      static_parents_[tfFrame(t.child_frame_id)] = tfFrame(t.header.frame_id);
-    }
-  }
-
-  std::string tfConflict(const std::string& parent, const std::string& child) const {
-    // We never publish static links: any static link to our child is another's.
-    if (const std::optional<std::string> other = staticParent(child)) {
-      if (*other == parent)
-        return "'" + parent + " -> " + child +
-               "' is already on tf_static from another broadcaster: publishing it too would "
-               "give two sources of one link";
-      return "frame '" + child + "' has the static parent '" + *other +
-             "' on tf_static: publishing " + parent + " -> " + child +
-             " would give it a second parent";
-    }
-    std::string existing;
-    if (tf_buffer_->_getParent(child, ros::Time(0), existing)) {
-      if (existing != parent)
-        return "frame '" + child + "' already has the parent '" + existing +
-               "' on tf: publishing " + parent + " -> " + child + " would give it a second parent";
-      if (!published_edges_.count(parent + " -> " + child))
-        return "'" + parent + " -> " + child + "' is already on tf from another broadcaster";
-    }
-    std::string up = parent;  // no loop: the child must not be above the parent
-    for (int depth = 0; depth < 64 && tf_buffer_->_getParent(up, ros::Time(0), existing); ++depth) {
-      if (existing == child) {
-        std::string why = "'" + child + "' is above '" + parent + "' on tf: " + parent +
-                          " -> " + child + " would make a loop";
-        // Our own earlier link, kept by every tf listener that heard it: a static parent
-        // of that frame sent after it was dropped by them (tf2's TF_OLD_DATA), so they
-        // would keep the loop. Only restarting them clears it.
-        const std::string ours = existing + " -> " + up;
-        if (published_edges_.count(ours))
-          why += " through this nodelet's earlier " + ours + ": tf listeners that heard it keep it" +
-                 staticParentNote(up) +
-                 ": restart the pipeline and the tf listeners (rviz) with tf_mode:=below_odom, or "
-                 "start the static publisher first";
-        return why;
-      }
-      up = existing;
-    }
-    return {};
-  }
-
-  // ", and dropped the static parent 'p' of 'frame' sent after it" when /tf_static has one.
-  std::string staticParentNote(const std::string& frame) const {
-    const std::optional<std::string> parent = staticParent(frame);
-    return !parent ? std::string()
-                   : ", and dropped the static parent '" + *parent + "' of '" + frame +
-                         "' sent after it (TF_OLD_DATA)";
-  }
-
-  // frame's parent on /tf_static, as heard (tf2 may have dropped it: see onTfStatic).
-  std::optional<std::string> staticParent(const std::string& frame) const {
-    std::lock_guard<std::mutex> lock(static_mutex_);
-    const auto it = static_parents_.find(frame);
-    if (it == static_parents_.end()) return {};
-    return it->second;
-  }
+  // Static links' parents, for the tf checks (tf_tree_view.h).
+  void onTfStatic(const tf2_msgs::TFMessageConstPtr& msg) { tf_view_->noteStatic(*msg); }
 
   // The one transform this nodelet publishes for this image, if any (mutex_ held).
   std::optional<geometry_msgs::TransformStamped> transformFor(const Pose& ros_map_from_camera,
@@ -612,8 +483,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (!odom) return {};
       if (resolved_tf_mode_.empty()) {
         // A static parent first: tf2 drops one sent after a dynamic link to the same frame
-        // (ours, before a ~reset), so only /tf_static shows it (as to tfConflict).
-        std::string odom_parent = staticParent(odom_frame_).value_or("");
+        // (ours, before a ~reset), so only /tf_static shows it (as to TfTreeView::conflict).
+        std::string odom_parent = tf_view_->staticParent(odom_frame_).value_or("");
         const bool has_parent = !odom_parent.empty() ||
                                 tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
         resolved_tf_mode_ = tf_mode_ != "auto"                             ? tf_mode_
@@ -649,7 +520,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       child = camera_frame_.empty() ? tfFrame(header.frame_id) + "_estimate" : camera_frame_;
       parent_from_child = ros_map_from_camera;
     }
-    tf_conflict_ = tfConflict(parent, child);
+    tf_conflict_ = tf_view_->conflict(parent, child, published_edges_);
     if (!tf_conflict_.empty()) {
       NODELET_ERROR("tf refused, nothing more is published on tf (until ~reset): %s",
                     tf_conflict_.c_str());
@@ -1104,8 +975,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::Time missed_stamp_;      // ...for the odometry of the image of this stamp
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
-  mutable std::mutex static_mutex_;
-  std::map<std::string, std::string> static_parents_;  // child -> parent on /tf_static
   ros::ServiceServer reset_srv_, save_srv_;
   std::unique_ptr<dynamic_reconfigure::Server<PlanesConfig>> reconfigure_;
   std::map<std::string, std::string> cfg_names_;  // .cfg name -> table name
@@ -1115,6 +984,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::unique_ptr<TfTreeView> tf_view_;  // on tf_buffer_ (declared after it: goes first)
   RecentEvents problems_;  // refused tracks, camera_info, odometry
   static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
   static constexpr const char* kCameraSwitch = "tracks camera switch";  // (problems_ kind)
