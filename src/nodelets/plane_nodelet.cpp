@@ -336,6 +336,11 @@ class PlaneNodelet : public nodelet::Nodelet {
       last_planes_.reset();
       tf_conflict_.clear();
       resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
+      // Until the next tracks say otherwise (a paused robot's diagnostics kept the old map's).
+      status_ = "reset: the map starts over with the next tracks";
+      metric_source_.clear();
+      tf_edge_.clear();
+      map_frame_shared_.clear();
       ++resets_;
       NODELET_INFO("reset: the map and the camera pose start over");
       done = true;
@@ -521,6 +526,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       parent_from_child = ros_map_from_camera;
     }
     tf_conflict_ = tf_view_->conflict(parent, child, published_edges_);
+    if (!tf_conflict_.empty() && child == map_frame_)
+      tf_conflict_ += " (a second pipeline with the same map_frame? give each camera its own, "
+                      "e.g. map_frame:=robot1/plane_map)";
     if (!tf_conflict_.empty()) {
       NODELET_ERROR("tf refused, nothing more is published on tf (until ~reset): %s",
                     tf_conflict_.c_str());
@@ -529,6 +537,29 @@ class PlaneNodelet : public nodelet::Nodelet {
     tf_edge_ = parent + " -> " + child;
     published_edges_.insert(tf_edge_);
     return toTransform(parent_from_child, header.stamp, parent, child);
+  }
+
+  // Another pipeline publishing into this map_frame (mutex_ held; once a second): two
+  // robots or cameras launched with the default map_frame put two maps with unrelated
+  // origins into one frame, and every status was OK (hostile try).
+  void checkMapFrameShared() {
+    if (!tf_view_ || !publish_tf_ || tf_edge_.empty()) return;
+    const ros::WallTime now = ros::WallTime::now();
+    if (now - shared_checked_ < ros::WallDuration(1.0)) return;
+    shared_checked_ = now;
+    std::string foreign;
+    for (const std::string& edge : tf_view_->foreignLinks(map_frame_, published_edges_))
+      foreign += (foreign.empty() ? "" : ", ") + edge;
+    if (!foreign.empty() && foreign != map_frame_shared_)
+      NODELET_WARN("%s", mapFrameSharedText(foreign).c_str());
+    map_frame_shared_ = foreign;
+  }
+
+  std::string mapFrameSharedText(const std::string& foreign) const {
+    return "map_frame '" + map_frame_ + "' also holds " + foreign +
+           " from another broadcaster on /tf: a second pipeline (another camera or robot) with "
+           "the same map_frame puts a map with an unrelated origin into this frame; give each "
+           "camera its own map_frame (e.g. map_frame:=robot1/plane_map)";
   }
 
   // Tracks wait (in order, without blocking a callback) until tf has the odometry at
@@ -815,6 +846,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         if (cloud_pub_.getNumSubscribers() > 0 && pipeline_->poseEstimator())
           cloud = toCloud(map_header, *pipeline_->poseEstimator(), pipeline_->map());
         if (!before_jump) tf = transformFor(ros_map_from_camera, odom, msg.header);
+        checkMapFrameShared();
       }
       last_planes_ = planes;
       if (debug_pub_.getNumSubscribers() > 0) {
@@ -848,6 +880,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     StatusProblems problems;
     if (!tf_conflict_.empty())
       problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
+    else if (!map_frame_shared_.empty())
+      problems.add(DiagnosticStatus::WARN, "tf", mapFrameSharedText(map_frame_shared_));
     // A metric source that cannot give metres is an error until it is set.
     const std::string blocked = metricSourceProblem(node_);
     if (!blocked.empty()) problems.add(DiagnosticStatus::ERROR, "configuration", blocked);
@@ -920,6 +954,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
       problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
     problems.report(status, status_.empty() ? "no tracks yet" : status_);
+    // The state also when a problem is the summary.
+    status.add("state", status_.empty() ? "no tracks yet" : status_);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
     status.add("camera switches (total)", camera_switches_);
@@ -1030,6 +1066,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string tf_conflict_;       // why tf was refused; "" when fine
   std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)
   std::string tf_edge_;           // what is published
+  std::string map_frame_shared_;  // others' links into map_frame ("" when none)
+  ros::WallTime shared_checked_;  // (checkMapFrameShared)
   std::set<std::string> published_edges_;  // links this nodelet has put on tf
 };
 

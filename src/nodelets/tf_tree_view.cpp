@@ -63,8 +63,12 @@ std::string TfTreeView::odometryProblem(const std::string& camera,
   if (!buffer_._frameExists(camera))
     return "camera frame '" + camera + "' (the images' header.frame_id) is not in the tf tree" +
            fix;
-  if (!buffer_._frameExists(odom_frame))
-    return "odom_frame '" + odom_frame + "' is not on tf: no odometry published (yet)";
+  if (!buffer_._frameExists(odom_frame)) {
+    // Where the camera's tree goes instead: a robot's namespaced odometry (robot1/odom).
+    const std::string root = ancestors(camera).back();
+    return "odom_frame '" + odom_frame + "' is not on tf: no odometry published (yet)" +
+           (root != camera ? "; the camera's tf goes up to '" + root + "'" : std::string());
+  }
   if (!buffer_.canTransform(odom_frame, camera, ros::Time(0))) {
     // Where the camera's chain ends: a URDF frame whose joint's publisher has not sent
     // yet (robot_state_publisher at start) is no wrong frame_id.
@@ -117,6 +121,19 @@ std::string TfTreeView::conflict(const std::string& parent, const std::string& c
     up = existing;
   }
   return {};
+}
+
+std::vector<std::string> TfTreeView::foreignLinks(const std::string& frame,
+                                                  const std::set<std::string>& published) const {
+  std::vector<std::string> frames, foreign;
+  buffer_._getFrameStrings(frames);
+  std::string parent;
+  for (const std::string& f : frames) {
+    if (!buffer_._getParent(f, ros::Time(0), parent) || (f != frame && parent != frame)) continue;
+    const std::string edge = parent + " -> " + f;
+    if (!published.count(edge) && staticParent(f) != parent) foreign.push_back(edge);
+  }
+  return foreign;
 }
 
 std::string TfTreeView::staticParentNote(const std::string& frame) const {

@@ -49,6 +49,12 @@ class TfTreeView {
   // published: the links this nodelet has put on tf ("parent -> child").
   std::string conflict(const std::string& parent, const std::string& child,
                        const std::set<std::string>& published) const;
+  // The links on /tf (dynamic: a static one, e.g. ground_truth_frame's or a user's marker
+  // frame, is hung there on purpose) into or out of `frame` that this nodelet did not
+  // publish ("parent -> child"): another pipeline publishing into the same map_frame puts
+  // a map with an unrelated origin there (hostile try: two robots, both plane_map).
+  std::vector<std::string> foreignLinks(const std::string& frame,
+                                        const std::set<std::string>& published) const;
 
  private:
   // ", and dropped the static parent 'p' of 'frame' sent after it" when /tf_static has one.

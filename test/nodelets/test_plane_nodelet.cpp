@@ -988,6 +988,16 @@ TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
   EXPECT_FALSE(nowhere.response.success);
 
   ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));
+  {
+    // Before the next tracks (a paused robot): the status is the reset's, not the old map's
+    // (hostile try: "tracking (landmarks)" and its tf link stayed).
+    DiagnosticsProbe paused(nh_, "plane_detector: planes");
+    ASSERT_TRUE(paused.waitFresh());
+    EXPECT_EQ(paused.value("state"), "reset: the map starts over with the next tracks");
+    EXPECT_EQ(paused.value("tf"), "nothing published yet");
+    EXPECT_EQ(paused.value("metric source").rfind("none yet", 0), 0u)
+        << paused.value("metric source");
+  }
   // The stream goes on (stamps keep increasing): only the reset empties the map.
   const PlaneArrayConstPtr after = drive(images / 30.0, 1, 3000);
   ASSERT_TRUE(after);

@@ -64,8 +64,10 @@ TEST(TfTreeView, OdometryProblemsSayWhatIsMissing) {
   EXPECT_NE(robot.view.odometryProblem("", "odom").find("empty frame_id"), std::string::npos);
   EXPECT_NE(robot.view.odometryProblem("camera_optical", "odom").find("is not in the tf tree"),
             std::string::npos);
-  EXPECT_NE(robot.view.odometryProblem("camera", "map").find("'map' is not on tf"),
-            std::string::npos);
+  const std::string no_odom = robot.view.odometryProblem("camera", "map");
+  EXPECT_NE(no_odom.find("'map' is not on tf"), std::string::npos) << no_odom;
+  // Where the camera's tf goes instead (a namespaced robot1/odom against odom).
+  EXPECT_NE(no_odom.find("the camera's tf goes up to 'odom'"), std::string::npos) << no_odom;
   // A head on joints whose publisher has not sent yet: the chain ends at 'head'.
   robot.addStatic("head", "head_camera");
   robot.buffer.setTransform(link("map", "elsewhere", 1.0), "other");
@@ -128,4 +130,24 @@ TEST(TfTreeView, ALoopThroughOurOwnEarlierLinkSaysHowToClearIt) {
       << loop;
   EXPECT_NE(loop.find("restart the pipeline"), std::string::npos) << loop;
   EXPECT_EQ(loop.find("dropped the static parent"), std::string::npos) << loop;
+}
+
+TEST(TfTreeView, ForeignLinksOfAMapFrameAreOthersDynamicOnes) {
+  Robot robot;
+  // Ours: plane_map -> odom. Another pipeline's: plane_map -> robot2/odom (dynamic). A
+  // frame hung under plane_map on purpose: plane_map -> truth (static).
+  robot.buffer.setTransform(link("plane_map", "odom", 2.0), "us");
+  EXPECT_TRUE(robot.view.foreignLinks("plane_map", {"plane_map -> odom"}).empty());
+  robot.addStatic("plane_map", "truth");
+  EXPECT_TRUE(robot.view.foreignLinks("plane_map", {"plane_map -> odom"}).empty());
+  robot.buffer.setTransform(link("plane_map", "robot2/odom", 2.0), "other");
+  EXPECT_EQ(robot.view.foreignLinks("plane_map", {"plane_map -> odom"}),
+            std::vector<std::string>{"plane_map -> robot2/odom"});
+  // Another's parent of the map frame counts too.
+  tf2::BufferCore buffer;
+  TfTreeView view(buffer);
+  buffer.setTransform(link("plane_map", "camera_estimate", 1.0), "us");
+  buffer.setTransform(link("robot2/odom", "plane_map", 1.0), "other");
+  EXPECT_EQ(view.foreignLinks("plane_map", {"plane_map -> camera_estimate"}),
+            std::vector<std::string>{"robot2/odom -> plane_map"});
 }

@@ -9,13 +9,13 @@
 //    publishes map -> odom: the nodelet attaches odom -> plane_map instead. A second
 //    nodelet told to publish the camera's own frame refuses (ERROR in diagnostics).
 #include <diagnostic_msgs/DiagnosticArray.h>
-#include <std_srvs/Empty.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <std_srvs/Empty.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -23,6 +23,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 
@@ -78,9 +79,8 @@ struct Answers {
   std::map<uint64_t, PlaneArrayConstPtr> by_stamp;
   ros::Subscriber sub;
   Answers(ros::NodeHandle& nh, const std::string& topic) {
-    sub = nh.subscribe<PlaneArray>(topic, 50, [this](const PlaneArrayConstPtr& m) {
-      by_stamp[m->header.stamp.toNSec()] = m;
-    });
+    sub = nh.subscribe<PlaneArray>(
+        topic, 50, [this](const PlaneArrayConstPtr& m) { by_stamp[m->header.stamp.toNSec()] = m; });
   }
   PlaneArrayConstPtr wait(const ros::Time& stamp, double seconds = 10.0) {
     const uint64_t key = stamp.toNSec();
@@ -156,8 +156,10 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
       const PlaneArrayConstPtr b = rear_planes.wait(ros::Time(r.stamp));
       const PlaneArrayConstPtr c = side_planes.wait(ros::Time(r.stamp));
       if (!a || !b || !c) return false;
-      if (k >= 150 && a->metric) front_errors.push_back(positionError(*a, front.truthMapFromCamera(t)));
-      if (k >= 150 && b->metric) rear_errors.push_back(positionError(*b, rear.truthMapFromCamera(t)));
+      if (k >= 150 && a->metric)
+        front_errors.push_back(positionError(*a, front.truthMapFromCamera(t)));
+      if (k >= 150 && b->metric)
+        rear_errors.push_back(positionError(*b, rear.truthMapFromCamera(t)));
       ros::WallDuration(1.0 / 60).sleep();  // about 30 Hz with the answers' time
     }
     return true;
@@ -182,8 +184,8 @@ TEST(TwoCameras, RawAndRectifiedInOneManagerUnderSimTime) {
   EXPECT_LT(front_worst, 0.1);
   EXPECT_LT(rear_worst, 0.1);
   EXPECT_LT(rear_worst, front_worst + 0.05);  // the same accuracy
-  EXPECT_TRUE(buffer.canTransform("front_map", "front_optical_estimate", ros::Time(0),
-                                  ros::Duration(2.0)));
+  EXPECT_TRUE(
+      buffer.canTransform("front_map", "front_optical_estimate", ros::Time(0), ros::Duration(2.0)));
   EXPECT_TRUE(
       buffer.canTransform("rear_map", "rear_optical_estimate", ros::Time(0), ros::Duration(2.0)));
 
@@ -303,8 +305,8 @@ TEST(TwoCameras, ABagLoopStartsTheMapOverWithoutTheOldLoopsTf) {
 
 // Every transform on /tf and /tf_static: the parents of each child, and who sent what.
 struct TfRecorder {
-  std::map<std::string, std::set<std::string>> parents;               // child -> parents
-  std::map<std::string, std::set<std::string>> edges_by_publisher;    // node -> "a -> b"
+  std::map<std::string, std::set<std::string>> parents;             // child -> parents
+  std::map<std::string, std::set<std::string>> edges_by_publisher;  // node -> "a -> b"
   ros::Subscriber tf, tf_static;
   explicit TfRecorder(ros::NodeHandle& nh) {
     tf = nh.subscribe("/tf", 100, &TfRecorder::record, this);
@@ -372,9 +374,9 @@ TEST(TfTree, StaysATreeWithOdometry) {
   // Odometry: the truth seen from an odometry origin 1 m aside and turned 0.3 rad about z
   // (odom is z up: REP 105); another localiser's map -> odom is a fixed shift.
   const Pose ros_from_target = rosMapFromTarget();
-  const Pose odom_from_rosmap{cv::Matx33d(std::cos(0.3), -std::sin(0.3), 0, std::sin(0.3),
-                                          std::cos(0.3), 0, 0, 0, 1),
-                              {1, 0.5, 0}};
+  const Pose odom_from_rosmap{
+      cv::Matx33d(std::cos(0.3), -std::sin(0.3), 0, std::sin(0.3), std::cos(0.3), 0, 0, 0, 1),
+      {1, 0.5, 0}};
   const Pose amcl_map_from_odom{cv::Matx33d::eye(), {-2, 3, 0}};
   const ros::Time start = ros::Time::now();
   PlaneArrayConstPtr last;
@@ -387,7 +389,8 @@ TEST(TfTree, StaysATreeWithOdometry) {
     TrackFrame f = world.frame(t);
     f.stamp = (start + ros::Duration((k + later) / 30.0)).toSec();
     const ros::Time stamp(f.stamp);  // what the tracks carry: the same nanoseconds on tf
-    truth_map_from_base = ros_from_target * world.truthMapFromCamera(t) * base_from_camera.inverse();
+    truth_map_from_base =
+        ros_from_target * world.truthMapFromCamera(t) * base_from_camera.inverse();
     std::vector<geometry_msgs::TransformStamped> out;
     geometry_msgs::TransformStamped odom;
     odom.header.stamp = stamp;
@@ -429,7 +432,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
   }
   EXPECT_EQ(last->status.rfind("tracking (odometry)", 0), 0u) << last->status;
   EXPECT_GT(with_odometry, 60);
-  EXPECT_LE(without_after_start, 2);  // a loaded machine may miss the wait now and then
+  EXPECT_LE(without_after_start, 2);     // a loaded machine may miss the wait now and then
   spinUntil([] { return false; }, 1.0);  // the last transforms arrive
 
   // A tree: every frame has one parent, the robot's frames keep theirs.
@@ -459,8 +462,8 @@ TEST(TfTree, StaysATreeWithOdometry) {
   }
   // plane_map -> base_link through tf, against the truth.
   ASSERT_TRUE(buffer.canTransform("plane_map", "base_link", last_stamp, ros::Duration(2.0)));
-  const Pose through_tf = fromTransformMsg(
-      buffer.lookupTransform("plane_map", "base_link", last_stamp).transform);
+  const Pose through_tf =
+      fromTransformMsg(buffer.lookupTransform("plane_map", "base_link", last_stamp).transform);
   const double error = cv::norm(through_tf.t - truth_map_from_base.t);
   std::printf("plane_map -> base_link via tf: %.3f m from the truth\n", error);
   EXPECT_LT(error, 0.1);
@@ -476,8 +479,8 @@ TEST(TfTree, StaysATreeWithOdometry) {
   // stamped after `after` heard, and an ERROR that names the second parent.
   auto expectOurLinkRefused = [&](const ros::Time& after, const std::string& beside) {
     int ours = 0, heard = 0;  // (heard: the subscriber is connected, odometry flows)
-    ros::Subscriber tf_sub = nh.subscribe<tf2_msgs::TFMessage>(
-        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+    ros::Subscriber tf_sub =
+        nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
           for (const auto& t : m->transforms) {
             ++heard;
             ours += t.child_frame_id == "odom" && t.header.frame_id == "plane_map" &&
@@ -510,8 +513,8 @@ TEST(TfTree, StaysATreeWithOdometry) {
     std_srvs::Empty reset;
     ASSERT_TRUE(ros::service::call("/camera/plane_detector/reset", reset));
     int above_after = 0, below_after = 0;
-    ros::Subscriber after_sub = nh.subscribe<tf2_msgs::TFMessage>(
-        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+    ros::Subscriber after_sub =
+        nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
           for (const auto& t : m->transforms) {
             above_after += t.child_frame_id == "odom" && t.header.frame_id == "plane_map";
             below_after += t.child_frame_id == "plane_map" && t.header.frame_id == "odom";
@@ -560,8 +563,8 @@ TEST(TfTree, StaysATreeWithOdometry) {
     std_srvs::Empty reset;
     ASSERT_TRUE(ros::service::call("/camera/plane_detector/reset", reset));
     int below_after = 0;
-    ros::Subscriber below_sub = nh.subscribe<tf2_msgs::TFMessage>(
-        "/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
+    ros::Subscriber below_sub =
+        nh.subscribe<tf2_msgs::TFMessage>("/tf", 100, [&](const tf2_msgs::TFMessageConstPtr& m) {
           for (const auto& t : m->transforms) {
             ours_after += t.child_frame_id == "odom" && t.header.frame_id == "plane_map";
             below_after += t.child_frame_id == "plane_map";
@@ -577,8 +580,7 @@ TEST(TfTree, StaysATreeWithOdometry) {
     EXPECT_EQ(below_after, 0) << "odom -> plane_map published: a loop for the listeners";
     ASSERT_TRUE(camera.waitFresh());
     EXPECT_EQ(camera.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << camera.message();
-    EXPECT_NE(camera.message().find("tf_mode:=below_odom"), std::string::npos)
-        << camera.message();
+    EXPECT_NE(camera.message().find("tf_mode:=below_odom"), std::string::npos) << camera.message();
   }
 
   // The nodelet told to publish the camera's own frame refused, loudly.
@@ -594,6 +596,65 @@ TEST(TfTree, StaysATreeWithOdometry) {
   EXPECT_NE(duplicate.message().find("'base_link -> camera_optical' is already on tf_static"),
             std::string::npos)
       << duplicate.message();
+}
+
+// Two pipelines with one map_frame (tf_shared_map.test): each WARNs, naming the other's link;
+// a static frame hung under a map_frame on purpose is no other pipeline.
+TEST(SharedMapFrame, TwoPipelinesInOneMapFrameAreTold) {
+  ros::NodeHandle nh;
+  SyntheticTracks world("wheeled");
+  const std::vector<std::string> robots{"robot1", "robot2", "robot3"};
+  std::vector<ros::Publisher> tracks, infos;
+  std::vector<std::unique_ptr<Answers>> planes;
+  for (const std::string& r : robots) {
+    tracks.push_back(nh.advertise<Tracks>("/" + r + "/tracks", 20));
+    infos.push_back(nh.advertise<sensor_msgs::CameraInfo>("/" + r + "/camera_info", 1, true));
+    infos.back().publish(cameraInfo(world.camera, world.camera, r + "/camera_optical"));
+    planes.push_back(std::make_unique<Answers>(nh, "/" + r + "/planes"));
+  }
+  spinUntil(
+      [&] {
+        for (size_t i = 0; i < robots.size(); ++i)
+          if (tracks[i].getNumSubscribers() == 0 || planes[i]->sub.getNumPublishers() == 0)
+            return false;
+        return true;
+      },
+      30.0);
+  // robot3's ground truth hung under its map, as ground_truth_frame does: static.
+  tf2_ros::StaticTransformBroadcaster hanger;
+  geometry_msgs::TransformStamped truth;
+  truth.header.stamp = ros::Time::now();
+  truth.header.frame_id = "robot3/plane_map";
+  truth.child_frame_id = "robot3/truth";
+  truth.transform.rotation.w = 1.0;
+  hanger.sendTransform(truth);
+  const ros::Time start = ros::Time::now();
+  for (int k = 0; k < 120; ++k) {
+    TrackFrame f = world.frame(k / 30.0);
+    f.stamp = (start + ros::Duration(k / 30.0)).toSec();
+    for (size_t i = 0; i < robots.size(); ++i)
+      tracks[i].publish(toTracks(f, robots[i] + "/camera_optical"));
+    for (size_t i = 0; i < robots.size(); ++i)
+      ASSERT_TRUE(planes[i]->wait(ros::Time(f.stamp))) << robots[i] << " image " << k;
+  }
+  const PlaneArrayConstPtr last = planes[0]->by_stamp.rbegin()->second;
+  ASSERT_EQ(last->status.rfind("tracking", 0), 0u) << last->status;  // a map on tf
+  for (const std::string& r : {std::string("robot1"), std::string("robot2")}) {
+    const std::string other = r == "robot1" ? "robot2" : "robot1";
+    DiagnosticsProbe probe(nh, r + "/plane_detector: planes");
+    ASSERT_TRUE(probe.waitFresh());
+    EXPECT_EQ(probe.level(), diagnostic_msgs::DiagnosticStatus::WARN) << probe.message();
+    const std::string tf = probe.value("problem: tf");
+    EXPECT_NE(tf.find("map_frame 'plane_map' also holds plane_map -> " + other +
+                      "/camera_optical_estimate"),
+              std::string::npos)
+        << tf;
+    EXPECT_NE(tf.find("give each camera its own map_frame"), std::string::npos) << tf;
+  }
+  DiagnosticsProbe own(nh, "robot3/plane_detector: planes");
+  ASSERT_TRUE(own.waitFresh());
+  EXPECT_EQ(own.level(), diagnostic_msgs::DiagnosticStatus::OK) << own.message();
+  EXPECT_EQ(own.value("tf"), "robot3/plane_map -> robot3/camera_optical_estimate");
 }
 
 }  // namespace
