@@ -1,13 +1,13 @@
 #include "mono_plane_detection/mapping/plane_pipeline.h"
 
-#include "mono_plane_detection/mapping/plane_from_motion.h"
-
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
+
+#include "mono_plane_detection/mapping/plane_from_motion.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -83,8 +83,7 @@ std::string PlanePipeline::setCamera(const cv::Matx33d& K, const cv::Mat& distor
   return {};
 }
 
-void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap,
-                                      double max_gap_s) {
+void PlanePipeline::setPerImageParams(const PlaneParams& planes, int frame_gap, double max_gap_s) {
   params_.planes = planes;
   params_.frame_gap = frame_gap;
   params_.max_gap_s = max_gap_s;
@@ -100,6 +99,7 @@ void PlanePipeline::reset() {
   stream_.reset();
   previous_planes_.clear();
   motion_planes_.clear();
+  newest_id_ = 0;
 }
 
 PipelineResult PlanePipeline::process(const TrackFrame& frame,
@@ -122,6 +122,20 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     } else {
       result.missing_images = stream_.add(since_ns);
     }
+  }
+  if (!frame.ids.empty()) {
+    const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
+    if (!history_.empty() && newest < newest_id_) {
+      const std::vector<std::uint64_t>& last = history_.back().frame.ids;
+      const bool none_left = std::none_of(frame.ids.begin(), frame.ids.end(), [&](auto id) {
+        return std::find(last.begin(), last.end(), id) != last.end();
+      });
+      if (none_left) {
+        reset();
+        result.was_reset = result.tracker_restarted = true;
+      }
+    }
+    newest_id_ = std::max(newest_id_, newest);
   }
 
   if (pose_) result.pose = pose_->update(frame, odom_from_camera);
@@ -161,8 +175,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       long off_largest = 0;
       for (int label : result.segmentation.labels) off_largest += label >= 2;
       if (off_largest >= params_.planes.min_plane_support && result.pose &&
-          result.pose->source == PoseSource::kOdometry &&
-          image_count_ % kOdometryCheckEvery == 0) {
+          result.pose->source == PoseSource::kOdometry && image_count_ % kOdometryCheckEvery == 0) {
         std::unordered_map<std::uint64_t, size_t> now;
         for (size_t i = 0; i < frame.ids.size(); ++i) now.emplace(frame.ids[i], i);
         for (const PastFrame& old : history_) {
@@ -237,8 +250,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     std::vector<PlaneObservation> observations = observationsOf(result.planes, *result.pose);
     if (params_.motion_plane_images > 0 && !result.pure_rotation &&
         result.pose->source == PoseSource::kOdometry)
-      addMotionPlanes(result.planes, result.pose->map_from_camera, frame, normalized,
-                      observations);
+      addMotionPlanes(result.planes, result.pose->map_from_camera, frame, normalized, observations);
     const std::vector<int> map_ids = map_.update(observations, frame.stamp);
     for (size_t k = 0; k < map_ids.size(); ++k) result.planes[k].map_id = map_ids[k];
   }
@@ -258,7 +270,13 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     result.status = pose_->waitingFor();  // the target, odometry or the floor
   } else if (!pose_->initialised() && !result.pose) {
     result.state = PipelineState::kInitialising;
-    result.status = "target seen, initialising: waiting for camera motion (parallax)";
+    // (One image without all four corners is no news: a corner at the image's edge.)
+    result.status = pose_->startTargetUnseenS() > 0.5
+                        ? "target seen, initialising: the start-up target is out of view (the "
+                          "start needs it in two views with parallax)"
+                        : "target seen, initialising: waiting for camera motion (parallax)";
+    result.start_wait_s = pose_->startWaitS();
+    result.start_target_unseen_s = pose_->startTargetUnseenS();
   } else if (!result.pose) {
     result.state = PipelineState::kLost;
     result.status = "lost: too few mapped points in view";
@@ -270,8 +288,7 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     std::ostringstream why;
     why.precision(2);
     why << std::fixed << "; too little parallax (" << result.parallax_px
-        << " px to every image within reach, under min_parallax_px "
-        << params_.min_parallax_px
+        << " px to every image within reach, under min_parallax_px " << params_.min_parallax_px
         << ": nearly pure rotation or standing still): no planes segmented";
     result.status += why.str();
   }
@@ -371,7 +388,8 @@ void PlanePipeline::addMotionPlanes(const std::vector<ImagePlane>& planes,
     obs.measured_from = from;
     obs.normal_sigma_deg = 1 / std::sqrt(state.normal_weight);
     for (size_t i = 0; i < ids.size(); ++i) {
-      const auto landmark = std::find(observations[k].ids.begin(), observations[k].ids.end(), ids[i]);
+      const auto landmark =
+          std::find(observations[k].ids.begin(), observations[k].ids.end(), ids[i]);
       if (landmark != observations[k].ids.end()) {
         const size_t at = static_cast<size_t>(landmark - observations[k].ids.begin());
         obs.ids.push_back(ids[i]);
@@ -431,7 +449,8 @@ double rotationFreeParallax(const std::vector<cv::Vec3d>& a, const std::vector<c
     residual.reserve(a.size());
     for (size_t i = 0; i < a.size(); ++i) {
       const cv::Vec3d r = Rm * a[i];
-      residual.push_back(std::hypot(r[0] / r[2] - b[i][0] / b[i][2], r[1] / r[2] - b[i][1] / b[i][2]));
+      residual.push_back(
+          std::hypot(r[0] / r[2] - b[i][0] / b[i][2], r[1] / r[2] - b[i][1] / b[i][2]));
     }
     std::vector<double> sorted = residual;
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());

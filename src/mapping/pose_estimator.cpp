@@ -81,6 +81,8 @@ void PoseEstimator::reset() {
   map_from_odom_.reset();
   initialised_ = false;
   first_view_.reset();
+  start_first_stamp_ = start_target_stamp_ = -1;
+  start_wait_s_ = start_target_unseen_s_ = 0;
   metric_ = MetricSource::kNone;
   floor_reason_.clear();
   floor_views_.clear();
@@ -152,7 +154,19 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
                              : "floor found, checking it against the map's floor";
     return {};
   }
+  start_wait_s_ = start_target_unseen_s_ = 0;
   if (!initialised_) {  // nothing is triangulated before the start
+    if (metric_ == MetricSource::kTarget) {
+      bool in_view = target_ids_.size() == 4;
+      for (std::uint64_t id : target_ids_)
+        in_view = in_view && std::find(frame.ids.begin(), frame.ids.end(), id) != frame.ids.end();
+      if (start_first_stamp_ < 0) start_first_stamp_ = frame.stamp;
+      if (in_view) start_target_stamp_ = frame.stamp;
+      start_wait_s_ = std::max(0.0, frame.stamp - start_first_stamp_);
+      start_target_unseen_s_ = start_target_stamp_ < 0
+                                   ? start_wait_s_
+                                   : std::max(0.0, frame.stamp - start_target_stamp_);
+    }
     const std::optional<PoseEstimate> start = initialise(frame, normalized);
     // With odometry, the start fixes where the odometry's origin sits in the map.
     if (start && odom_from_camera)
@@ -165,7 +179,8 @@ std::optional<PoseEstimate> PoseEstimator::update(const TrackFrame& frame,
   // then 0.24 m off on the rendered wheeled sequence), and started again on its return.
   const bool was_vision_only = vision_only_;
   vision_only_ = metric_ == MetricSource::kOdometry && !odom_from_camera;
-  if (was_vision_only && !vision_only_) restartProvisional(frame, normalized, *map_from_odom_ * *odom_from_camera);
+  if (was_vision_only && !vision_only_)
+    restartProvisional(frame, normalized, *map_from_odom_ * *odom_from_camera);
   if (odom_from_camera && map_from_odom_)
     estimate = PoseEstimate{*map_from_odom_ * *odom_from_camera, PoseSource::kOdometry, 0, 0};
   else
@@ -310,8 +325,9 @@ bool PoseEstimator::checkFloor(PoseEstimate& estimate,
     // The camera stays at one height over the floor (within 3 sigma of its bobbing): a
     // plane through a few floor landmarks and others, tilted, has the path climb it.
     if (relativeHeightSpread(fit, cameras) > 3 * p.check_camera_sigma) {
-      floor_reason_ = "started up to scale, waiting for the map's floor: the camera's "
-                      "height over it varies";
+      floor_reason_ =
+          "started up to scale, waiting for the map's floor: the camera's "
+          "height over it varies";
       return false;
     }
     if (moved < p.check_motion * height) {
@@ -503,7 +519,8 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
     TargetDetection d;
     d.found = true;
     for (int k = 0; k < 4; ++k)
-      d.corners[k] = cv::Point2f(static_cast<float>(corners[k].x), static_cast<float>(corners[k].y));
+      d.corners[k] =
+          cv::Point2f(static_cast<float>(corners[k].x), static_cast<float>(corners[k].y));
     const auto first_pose = cameraPoseFromTarget(d, cv::Matx33d::eye(), cv::Mat(), target_);
     if (first_pose) {
       const Pose first_from_map = first_pose->map_from_camera.inverse();
@@ -517,10 +534,9 @@ std::optional<PoseEstimate> PoseEstimator::initialise(const TrackFrame& frame,
     }
   }
   std::optional<cv::Matx33d> rotation;
-  if (first_view_->rotation_count > 1)
-    rotation = nearestRotation(first_view_->rotation_sum);
-  const TwoViewInit init = initialiseFromTwoViews(a, b, target, K_(0, 0), target_,
-                                                  params_.two_view, corners, rotation);
+  if (first_view_->rotation_count > 1) rotation = nearestRotation(first_view_->rotation_sum);
+  const TwoViewInit init =
+      initialiseFromTwoViews(a, b, target, K_(0, 0), target_, params_.two_view, corners, rotation);
   if (!init.ok) return {};
   first_view_.reset();
   placeStartLandmarks(frame, ids, a, b, init.points, init.points_map, init.parallax_deg,
@@ -624,12 +640,14 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
         view.floor_downs.clear();
       }
       std::unordered_map<std::uint64_t, cv::Vec3d> here;
-      for (size_t j = 0; j < f.point_index.size(); ++j) here.emplace(p.ids[f.point_index[j]], f.points[j]);
+      for (size_t j = 0; j < f.point_index.size(); ++j)
+        here.emplace(p.ids[f.point_index[j]], f.points[j]);
       if (view.floor_count < params_.floor.confirmations) {
         view.floor_points.push_back(std::move(here));
         view.floor_downs.push_back(f.down);
-        if (k == 0) reason = "floor found, seen " + std::to_string(view.floor_count) + " of " +
-                                 std::to_string(params_.floor.confirmations) + " times";
+        if (k == 0)
+          reason = "floor found, seen " + std::to_string(view.floor_count) + " of " +
+                   std::to_string(params_.floor.confirmations) + " times";
         continue;
       }
       // One pair's scale scatters (about 5 % on the rendered room): each earlier image's
@@ -641,7 +659,8 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
         std::vector<double> ratios;
         for (const auto& [id, x] : here) {
           const auto it = view.floor_points[j].find(id);
-          if (it != view.floor_points[j].end() && cv::norm(x) > 0) ratios.push_back(cv::norm(it->second) / cv::norm(x));
+          if (it != view.floor_points[j].end() && cv::norm(x) > 0)
+            ratios.push_back(cv::norm(it->second) / cv::norm(x));
         }
         if (ratios.size() >= 8) scales.push_back(median(ratios));
         down += view.floor_downs[j];
@@ -692,8 +711,8 @@ std::optional<PoseEstimate> PoseEstimator::startFromFloor(
     // Each point needs parallax of its own: those near the direction of motion have
     // none and would put PnP off from the first image on.
     const cv::Vec3d r1(a[i].x, a[i].y, 1.0), r2 = R21.t() * cv::Vec3d(b[i].x, b[i].y, 1.0);
-    const double parallax = std::acos(std::min(1.0, r1.dot(r2) / cv::norm(r1) / cv::norm(r2))) *
-                            180.0 / CV_PI;
+    const double parallax =
+        std::acos(std::min(1.0, r1.dot(r2) / cv::norm(r1) / cv::norm(r2))) * 180.0 / CV_PI;
     if (parallax < params_.min_parallax_deg) continue;
     const auto p = mono_plane_detection::triangulate(P1, P2, a[i], b[i]);
     if (!p || p->depth1 < params_.min_depth_m || p->depth2 < params_.min_depth_m ||

@@ -24,12 +24,11 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <pluginlib/class_list_macros.hpp>
+#include <sstream>
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
-#include "stretched_wait.h"
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/SaveMap.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
@@ -40,6 +39,7 @@
 #include "plane_messages.h"
 #include "recent_events.h"
 #include "ros_params.h"
+#include "stretched_wait.h"
 #include "tf_tree_view.h"
 
 namespace mono_plane_detection {
@@ -93,7 +93,8 @@ std::string mapUpText(const PlanePipeline& pipeline, const std::string& metric_s
 class PlaneNodelet : public nodelet::Nodelet {
  private:
   void onInit() override {
-    initOrAbandon(getName(), [this] { init(); }, [this] { abandonInit(); });
+    initOrAbandon(
+        getName(), [this] { init(); }, [this] { abandonInit(); });
   }
 
   void abandonInit() {
@@ -105,7 +106,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     image_sub_.shutdown();
     static_sub_.shutdown();
     debug_pub_.shutdown();
-    for (ros::Publisher* p : {&planes_pub_, &image_planes_pub_, &pose_pub_, &markers_pub_, &cloud_pub_})
+    for (ros::Publisher* p :
+         {&planes_pub_, &image_planes_pub_, &pose_pub_, &markers_pub_, &cloud_pub_})
       p->shutdown();
     reset_srv_.shutdown();
     save_srv_.shutdown();
@@ -152,10 +154,10 @@ class PlaneNodelet : public nodelet::Nodelet {
     // deeper (on a machine too slow for the image rate every answer is a queue length
     // old). The burst's answers are published at once, faster than roscpp's writer thread
     // may send them to another process: the per-image answers queue as deep.
-    const uint32_t burst =
-        odom_frame_.empty() ? 5
-                            : static_cast<uint32_t>(std::clamp<double>(
-                                  std::ceil(odom_wait_s_ * 30) + 2, 5, kMaxPending));
+    const uint32_t burst = odom_frame_.empty()
+                               ? 5
+                               : static_cast<uint32_t>(std::clamp<double>(
+                                     std::ceil(odom_wait_s_ * 30) + 2, 5, kMaxPending));
     planes_pub_ = nh.advertise<PlaneArray>("planes", burst);
     image_planes_pub_ = nh.advertise<PlaneArray>("image_planes", burst);
     pose_pub_ = nh.advertise<geometry_msgs::PoseStamped>("camera_pose", burst);
@@ -188,10 +190,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     diagnostics_.start(nh, pnh, getName(), "planes", this, &PlaneNodelet::diagnose, guard_,
                        node.expected_min_rate_hz, node.expected_max_rate_hz);
 
-    retry_timer_ = nh.createSteadyTimer(ros::WallDuration(kRetryS),
-                                      guard_.wrap("odometry wait",
-                                                  [this](const auto&) { drain(); }),
-                                      true /* oneshot */, false /* autostart */);
+    retry_timer_ = nh.createSteadyTimer(
+        ros::WallDuration(kRetryS), guard_.wrap("odometry wait", [this](const auto&) { drain(); }),
+        true /* oneshot */, false /* autostart */);
     // The map must follow every image, so tracks are always subscribed (the tracker
     // itself runs lazily: only while this nodelet listens); queued as deep as a burst.
     tracks_sub_ = nh.subscribe<Tracks>("tracks", burst,
@@ -272,8 +273,9 @@ class PlaneNodelet : public nodelet::Nodelet {
             [&](auto* v) {
               using T = std::remove_pointer_t<decltype(v)>;
               using Out = decltype(p.value);
-              if constexpr (std::is_same_v<Out, double> ? std::is_same_v<T, double>
-                                                        : std::is_integral_v<T> && !std::is_same_v<T, bool>)
+              if constexpr (std::is_same_v<Out, double>
+                                ? std::is_same_v<T, double>
+                                : std::is_integral_v<T> && !std::is_same_v<T, bool>)
                 p.value = static_cast<Out>(*v);
             },
             spec->field(node));
@@ -313,10 +315,11 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (!error.empty()) {
       ++dropped_info_;
       // One throttle per reason: an unknown distortion model after a zero K is named too.
-      if (problems_.note("camera_info " + reasonKind(error), "camera_info rejected: " + error, 10.0))
-        NODELET_WARN("camera_info rejected: %s; %s", error.c_str(),
-                     calibration_.latest() ? "the last usable one stays in use"
-                                           : "image-space planes only");
+      if (problems_.note("camera_info " + reasonKind(error), "camera_info rejected: " + error,
+                         10.0))
+        NODELET_WARN(
+            "camera_info rejected: %s; %s", error.c_str(),
+            calibration_.latest() ? "the last usable one stays in use" : "image-space planes only");
       return;
     }
     calibration_.offer(camera);  // (its size with binning and ROI applied)
@@ -327,7 +330,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     guard_.run("reset", [&] {
       {
         std::lock_guard<std::mutex> order(drain_mutex_);  // (drain_mutex_ before mutex_)
-        odometry_live_ = true;  // the odometry is waited for again
+        odometry_live_ = true;                            // the odometry is waited for again
       }
       std::lock_guard<std::mutex> lock(mutex_);
       pipeline_->reset();
@@ -338,10 +341,19 @@ class PlaneNodelet : public nodelet::Nodelet {
       resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
       // Until the next tracks say otherwise (a paused robot's diagnostics kept the old map's).
       status_ = "reset: the map starts over with the next tracks";
+      start_wait_s_ = start_target_unseen_s_ = 0;
       metric_source_.clear();
       tf_edge_.clear();
       map_frame_shared_.clear();
       ++resets_;
+      // rviz drops the old map's planes now, not when a new map first has markers
+      // (hostile try: they stayed 33 s and more).
+      visualization_msgs::MarkerArrayPtr clear(new visualization_msgs::MarkerArray);
+      clear->markers.emplace_back();
+      clear->markers.back().header.frame_id = map_frame_;
+      clear->markers.back().header.stamp = ros::Time::now();
+      clear->markers.back().action = visualization_msgs::Marker::DELETEALL;
+      markers_pub_.publish(clear);
       NODELET_INFO("reset: the map and the camera pose start over");
       done = true;
     });
@@ -365,8 +377,10 @@ class PlaneNodelet : public nodelet::Nodelet {
   // what to look at: the two configuration errors that do it (hostile try: odom_frame
   // base_link on a humanoid left the map empty with every status OK).
   std::string odometryMismatchText() const {
-    return "the odometry (tf " + odom_frame_ + " -> camera) does not move the camera as its "
-           "images show: " + pipeline_->odometryMonitor().summary() +
+    return "the odometry (tf " + odom_frame_ +
+           " -> camera) does not move the camera as its "
+           "images show: " +
+           pipeline_->odometryMonitor().summary() +
            "; is odom_frame the odometry's fixed frame (odom, not base_link or another frame "
            "on the robot), and the images' frame_id the camera's optical frame (z forward, x "
            "right, y down)?";
@@ -423,8 +437,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   // or when only this stamp is missing: the odometry stopped or is late).
   // rigid: tf_problem is odom_frame rigid with the camera (a configuration error).
   // stale_link: when only this stamp is missing, the link between them that lacks it.
-  std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem,
-                               bool& rigid, std::string& stale_link) {
+  std::optional<Pose> odometry(const std_msgs::Header& header, std::string& tf_problem, bool& rigid,
+                               std::string& stale_link) {
     tf_problem.clear();
     stale_link.clear();
     rigid = false;
@@ -490,17 +504,17 @@ class PlaneNodelet : public nodelet::Nodelet {
         // A static parent first: tf2 drops one sent after a dynamic link to the same frame
         // (ours, before a ~reset), so only /tf_static shows it (as to TfTreeView::conflict).
         std::string odom_parent = tf_view_->staticParent(odom_frame_).value_or("");
-        const bool has_parent = !odom_parent.empty() ||
-                                tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
-        resolved_tf_mode_ = tf_mode_ != "auto"                             ? tf_mode_
+        const bool has_parent =
+            !odom_parent.empty() || tf_buffer_->_getParent(odom_frame_, ros::Time(0), odom_parent);
+        resolved_tf_mode_ = tf_mode_ != "auto"                        ? tf_mode_
                             : has_parent && odom_parent != map_frame_ ? "below_odom"
-                                                                           : "above_odom";
+                                                                      : "above_odom";
         if (tf_mode_ == "auto") {
-          const std::string why =
-              resolved_tf_mode_ == "below_odom"
-                  ? "'" + odom_frame_ + "' already has the parent '" + odom_parent +
-                        "': publishing " + odom_frame_ + " -> " + map_frame_
-                  : "publishing " + map_frame_ + " -> " + odom_frame_;
+          const std::string why = resolved_tf_mode_ == "below_odom"
+                                      ? "'" + odom_frame_ + "' already has the parent '" +
+                                            odom_parent + "': publishing " + odom_frame_ + " -> " +
+                                            map_frame_
+                                      : "publishing " + map_frame_ + " -> " + odom_frame_;
           NODELET_INFO("tf_mode auto: %s", why.c_str());
         }
       }
@@ -527,8 +541,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     }
     tf_conflict_ = tf_view_->conflict(parent, child, published_edges_);
     if (!tf_conflict_.empty() && child == map_frame_)
-      tf_conflict_ += " (a second pipeline with the same map_frame? give each camera its own, "
-                      "e.g. map_frame:=robot1/plane_map)";
+      tf_conflict_ +=
+          " (a second pipeline with the same map_frame? give each camera its own, "
+          "e.g. map_frame:=robot1/plane_map)";
     if (!tf_conflict_.empty()) {
       NODELET_ERROR("tf refused, nothing more is published on tf (until ~reset): %s",
                     tf_conflict_.c_str());
@@ -618,7 +633,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       if (mustWait(*msg, waiting)) {
         if ((ros::SteadyTime::now() - arrived).toSec() < odom_wait_s_) return true;
         ++odom_waits_in_vain_;
-        odometry_live_ = false;  // waited in vain: the next tracks do not wait...
+        odometry_live_ = false;             // waited in vain: the next tracks do not wait...
         missed_stamp_ = msg->header.stamp;  // ...until tf's odometry comes within reach
       }
       TrackFrame frame;
@@ -651,9 +666,9 @@ class PlaneNodelet : public nodelet::Nodelet {
     // waited in vain and no further behind this image than odom_wait_s (odometry that
     // always lags more is not waited for at every image), or time went backwards.
     if (!odometry_live_)
-      odometry_live_ = msg.header.stamp < missed_stamp_ ||
-                       (newest > missed_stamp_ &&
-                        newest + ros::Duration(odom_wait_s_) >= msg.header.stamp);
+      odometry_live_ =
+          msg.header.stamp < missed_stamp_ ||
+          (newest > missed_stamp_ && newest + ros::Duration(odom_wait_s_) >= msg.header.stamp);
     return odometry_live_;
   }
 
@@ -698,8 +713,8 @@ class PlaneNodelet : public nodelet::Nodelet {
         // A recent problem, not a state: the diagnostics are OK again a while after the
         // last switch (the total stays).
         const std::string why = "tracks changed camera ('" + last_frame_id_ + "' " +
-                                sizeText(last_tracks_size_) + " -> '" + msg.header.frame_id +
-                                "' " + sizeText(frame.size) + ")";
+                                sizeText(last_tracks_size_) + " -> '" + msg.header.frame_id + "' " +
+                                sizeText(frame.size) + ")";
         if (problems_.note(kCameraSwitch, "tracks mix cameras: " + why))
           NODELET_WARN("%s: one camera per tracks topic, or the planes of neither are found",
                        why.c_str());
@@ -734,14 +749,14 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       // The tracker's start-up target seen while the map could not use it (no camera):
       // the tracker joins it once, so once its corners are gone the map waits for ever.
-      const bool target_in_tracks = std::find(frame.target_corner.begin(),
-                                              frame.target_corner.end(),
-                                              true) != frame.target_corner.end();
+      const bool target_in_tracks =
+          std::find(frame.target_corner.begin(), frame.target_corner.end(), true) !=
+          frame.target_corner.end();
       if (target_in_tracks) target_missed_ = !camera;
       if (camera) {
         pipeline_->setCamera(camera->K, camera->D);  // (checked on arrival; same: no change)
         undistortFisheye(frame, *camera);            // equidistant: pinhole pixels of the same K
-      } else if (pipeline_->hasCamera()) {  // (the map of that camera does not apply)
+      } else if (pipeline_->hasCamera()) {           // (the map of that camera does not apply)
         pipeline_ = std::make_unique<PlanePipeline>(params_);
         mapStartedOver();
       } else if (!calibration_.latest() && cameraInfoOverdue() && logNow("no camera_info", 10.0)) {
@@ -750,8 +765,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       }
       // The core's axes (y up) for the odometry: with metric_source odometry the ROS map
       // is then the odometry frame itself (docs/ros_interface.md).
-      const PipelineResult result =
-          pipeline_->process(frame, odom ? std::optional<Pose>(targetFromRosMap(*odom)) : std::nullopt);
+      const PipelineResult result = pipeline_->process(
+          frame, odom ? std::optional<Pose>(targetFromRosMap(*odom)) : std::nullopt);
       const PoseEstimator* estimator = pipeline_->poseEstimator();
       metric_source_ = estimator ? toString(estimator->metricSource()) : "";
       // The tf of the odometry source stopped: vision carries the pose (landmarks in the
@@ -768,15 +783,28 @@ class PlaneNodelet : public nodelet::Nodelet {
         // Rare (a bag loop): every time while loops come at most once a second, on the
         // wall clock (a throttle on ros::Time was silenced by the loop itself); a flood
         // of stamps going back and forth is limited as the tracker limits it.
-        if (logged_.note("backwards", "", 5.0, kRareEventBurst))
+        if (result.tracker_restarted) {
+          // A reloaded or respawned tracker: its new tracks are no points of this map.
           NODELET_WARN(
-              "tracks stamp %.3f is before the previous one: time went backwards (bag "
-              "loop?), the map starts over",
-              frame.stamp);
-        mapStartedOver(true);
-        ++resets_;
-        ++backwards_resets_;
-        stream_health_.wentBackwards();
+              "the tracker started over (its track ids began again, none of the last "
+              "image's left: a reloaded or respawned tracker nodelet?): the map starts over%s",
+              node_.pipeline.pose.metric_source == "target"
+                  ? "; show the start-up target to the camera again"
+                  : "");
+          mapStartedOver();
+          ++resets_;
+          ++tracker_restarts_;
+        } else {
+          if (logged_.note("backwards", "", 5.0, kRareEventBurst))
+            NODELET_WARN(
+                "tracks stamp %.3f is before the previous one: time went backwards (bag "
+                "loop?), the map starts over",
+                frame.stamp);
+          mapStartedOver(true);
+          ++resets_;
+          ++backwards_resets_;
+          stream_health_.wentBackwards();
+        }
         // Under simulated time the listener cleared its buffer when it saw the clock go
         // back, then took in what was queued before the jump: our own transform of the
         // previous loop's last images among it (measured: 59 TF_OLD_DATA in a loop of the
@@ -794,7 +822,7 @@ class PlaneNodelet : public nodelet::Nodelet {
             "%.3f s without tracks: tracking lost, waiting for %s to place the camera "
             "again",
             result.pause_s,
-            !odom_frame_.empty()                                  ? "the odometry"
+            !odom_frame_.empty()                                   ? "the odometry"
             : node_.pipeline.pose.metric_source == "camera_height" ? "the map"
                                                                    : "the map or the target");
       // One line per change of the status (the pose's source too: "tracking (target)" ->
@@ -822,6 +850,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       stream_health_.received(result.missing_images);
       status_ = result.status;
       state_ = result.state;
+      start_wait_s_ = result.start_wait_s;
+      start_target_unseen_s_ = result.start_target_unseen_s;
       observed_ = result.planes.size();
       std_msgs::Header map_header = msg.header;
       map_header.frame_id = map_frame_;
@@ -928,15 +958,29 @@ class PlaneNodelet : public nodelet::Nodelet {
                             : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
     const double waited_s = target_wait_.seconds();  // (0 unless waiting for the start)
     if (state_ == PipelineState::kWaitingForTarget && waited_s > target_timeout_s_)
+      problems.add(
+          DiagnosticStatus::WARN, "metric start",
+          (node_.pipeline.pose.metric_source == "target"
+               ? "start-up target not seen for " + std::to_string(static_cast<long>(waited_s)) +
+                     " s: show it to the camera, or start the metres without it "
+                     "(metric_source odometry with odom_frame, or camera_height "
+                     "with camera_height_m)"
+               : "no metric start (" + status_ + ") for " +
+                     std::to_string(static_cast<long>(waited_s)) + " s"));
+    // The target start that cannot finish (hostile try: OK for 550 images).
+    if (state_ == PipelineState::kInitialising && start_target_unseen_s_ > kStartTargetGoneS)
       problems.add(DiagnosticStatus::WARN, "metric start",
-                   (node_.pipeline.pose.metric_source == "target"
-                        ? "start-up target not seen for " +
-                              std::to_string(static_cast<long>(waited_s)) +
-                              " s: show it to the camera, or start the metres without it "
-                              "(metric_source odometry with odom_frame, or camera_height "
-                              "with camera_height_m)"
-                        : "no metric start (" + status_ + ") for " +
-                              std::to_string(static_cast<long>(waited_s)) + " s"));
+                   "the start-up target left the view " + secondsText(start_target_unseen_s_) +
+                       " ago, before the start finished (it needs the target in two views "
+                       "with parallax): show it to the camera again and move a few cm "
+                       "sideways; if its corners were lost, the tracker looks for it again "
+                       "only after its ~reset");
+    else if (state_ == PipelineState::kInitialising && start_wait_s_ > target_timeout_s_)
+      problems.add(DiagnosticStatus::WARN, "metric start",
+                   "the start has waited " + secondsText(start_wait_s_) +
+                       " for parallax with the target in view: move the camera a few cm "
+                       "sideways (or towards it) while it sees the target; turning on the "
+                       "spot gives no parallax");
     // The stream lately (as the tracker's).
     for (const auto& [key, text] : stream_health_.problems(
              "tracks",
@@ -972,14 +1016,16 @@ class PlaneNodelet : public nodelet::Nodelet {
                      : !publish_tf_        ? std::string("off")
                      : tf_edge_.empty()    ? std::string("nothing published yet")
                                            : tf_edge_);
-    status.add("metric source", metric_source_.empty() ? "none yet (" + node_.pipeline.pose.metric_source + ")"
-                                                       : metric_source_);
+    status.add("metric source", metric_source_.empty()
+                                    ? "none yet (" + node_.pipeline.pose.metric_source + ")"
+                                    : metric_source_);
     status.add("map up (map/up_sigma_deg)", mapUpText(*pipeline_, metric_source_));
     status.add("tracks with camera_info of another size (total)", info_size_mismatch_);
     status.add("tracks with camera_info of another frame_id (total)", info_frame_mismatch_);
     // Every start over of the map: ~reset calls and time going backwards (a bag loop).
     status.add("resets (total)", resets_);
     status.add("resets: time went backwards (total)", backwards_resets_);
+    status.add("resets: the tracker started over (total)", tracker_restarts_);
     status.add("reconfigurations (total)", reconfigures_);
     status.add("planes in this image", observed_);
     status.add("planes in the map", pipeline_->map().planes().size());
@@ -987,8 +1033,8 @@ class PlaneNodelet : public nodelet::Nodelet {
       status.add("landmarks", pipeline_->poseEstimator()->landmarks().size());
   }
 
-  CallbackGuard guard_;  // first member: the last destroyed
-  PlaneNodeParams node_;  // as read, then as reconfigured
+  CallbackGuard guard_;                          // first member: the last destroyed
+  PlaneNodeParams node_;                         // as read, then as reconfigured
   std::vector<std::string> start_errors_;        // parameters refused at start
   std::vector<std::string> reconfigure_errors_;  // refused by the last reconfigure
   PipelineParams params_;
@@ -996,6 +1042,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string map_frame_, odom_frame_, camera_frame_, transport_, tf_mode_;
   bool publish_tf_ = true, rectified_ = false;
   double target_timeout_s_ = 30;
+  double start_wait_s_ = 0, start_target_unseen_s_ = 0;  // PipelineResult's, last tracks
+  static constexpr double kStartTargetGoneS = 2.0;       // a target out of view longer: WARN
 
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_, static_sub_;
@@ -1007,8 +1055,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     ros::SteadyTime arrived;  // (steady clock)
   };
   std::deque<PendingTracks> pending_;
-  bool odometry_live_ = true;   // (drain_mutex_) false after a wait in vain...
-  ros::Time missed_stamp_;      // ...for the odometry of the image of this stamp
+  bool odometry_live_ = true;  // (drain_mutex_) false after a wait in vain...
+  ros::Time missed_stamp_;     // ...for the odometry of the image of this stamp
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   ros::ServiceServer reset_srv_, save_srv_;
@@ -1020,8 +1068,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformBroadcaster> broadcaster_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
-  std::unique_ptr<TfTreeView> tf_view_;  // on tf_buffer_ (declared after it: goes first)
-  RecentEvents problems_;  // refused tracks, camera_info, odometry
+  std::unique_ptr<TfTreeView> tf_view_;     // on tf_buffer_ (declared after it: goes first)
+  RecentEvents problems_;                   // refused tracks, camera_info, odometry
   static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
   static constexpr const char* kCameraSwitch = "tracks camera switch";  // (problems_ kind)
   NodeletDiagnostics diagnostics_;
@@ -1032,42 +1080,45 @@ class PlaneNodelet : public nodelet::Nodelet {
   long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
   long info_frame_mismatch_ = 0;        // tracks whose camera_info names another frame
   long backwards_resets_ = 0;           // map resets because time went backwards
+  long tracker_restarts_ = 0;           // map resets because the tracker started over
   std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
   bool odom_rigid_ = false;             // ...because odom_frame is rigid with the camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
-  bool reset_markers_ = false;
+  // The next markers begin with DELETEALL: true at start too, so a reloaded or respawned
+  // nodelet clears the old one's planes from rviz (hostile try: they stayed beside the new).
+  bool reset_markers_ = true;
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;
   std::string last_status_key_;  // the status last logged, without its "; ..." remark
-  long missing_tracks_ = 0;        // tracks missing from the stream, total
-  StreamHealth stream_health_;     // tracks missing, time going back (last 10 s)
-  ros::WallTime first_tracks_;  // wall time of the first tracks (camera_info's grace)
+  long missing_tracks_ = 0;      // tracks missing from the stream, total
+  StreamHealth stream_health_;   // tracks missing, time going back (last 10 s)
+  ros::WallTime first_tracks_;   // wall time of the first tracks (camera_info's grace)
   long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
        resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
   std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
-  StretchedWait target_wait_;  // for the metric start, in tracks stamps
+  StretchedWait target_wait_;                // for the metric start, in tracks stamps
   std::optional<Pose> last_odom_;
   ros::Time last_odom_stamp_;
   std::string last_frame_id_;
   cv::Size last_tracks_size_;
   size_t observed_ = 0;
   PlaneArrayConstPtr last_planes_;
-  std::string metric_source_;     // the source that started the map, "" before
+  std::string metric_source_;      // the source that started the map, "" before
   bool odometry_stopped_ = false;  // odom_frame set but no odometry for the last image
   std::string odom_stale_link_;    // then the link on tf that lacked its stamp, if found
   // The last tracks with the start-up target's corners came without a camera (no
   // camera_info): the map never saw the target (hostile try: camera_info 2.5 s late).
   bool target_missed_ = false;
-  std::string resolved_tf_mode_;  // above_odom | below_odom once decided
-  std::string tf_conflict_;       // why tf was refused; "" when fine
-  std::string target_mismatch_;   // the tracker's target is not ours (last flagged tracks)
-  std::string tf_edge_;           // what is published
-  std::string map_frame_shared_;  // others' links into map_frame ("" when none)
-  ros::WallTime shared_checked_;  // (checkMapFrameShared)
+  std::string resolved_tf_mode_;           // above_odom | below_odom once decided
+  std::string tf_conflict_;                // why tf was refused; "" when fine
+  std::string target_mismatch_;            // the tracker's target is not ours (last flagged tracks)
+  std::string tf_edge_;                    // what is published
+  std::string map_frame_shared_;           // others' links into map_frame ("" when none)
+  ros::WallTime shared_checked_;           // (checkMapFrameShared)
   std::set<std::string> published_edges_;  // links this nodelet has put on tf
 };
 

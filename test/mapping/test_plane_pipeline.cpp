@@ -122,6 +122,78 @@ TEST(PlanePipeline, WaitsForTheTarget) {
   EXPECT_FALSE(r.planes.empty());  // still found in the image
 }
 
+// A target start that cannot finish says so (hostile try: "waiting for camera motion" for 550
+// images while the camera travelled 3 m, diagnostics OK): the target seen on a still camera,
+// then gone (its corners no longer tracked) while the camera moves.
+TEST(PlanePipeline, AStartWhoseTargetLeftTheViewSaysSo) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k < 150; ++k) {
+    // Still for 1 s (the first image's view, again and again): no parallax.
+    TrackFrame f = world.frame(k < 30 ? 0.0 : k / 30.0);
+    f.stamp = 1000 + k / 30.0;
+    if (k >= 30) {  // then the target's corners are gone
+      TrackFrame kept = f;
+      kept.ids.clear();
+      kept.pixels.clear();
+      kept.target_corner.clear();
+      for (size_t i = 0; i < f.ids.size(); ++i)
+        if (!f.target_corner[i]) {
+          kept.ids.push_back(f.ids[i]);
+          kept.pixels.push_back(f.pixels[i]);
+          kept.target_corner.push_back(false);
+        }
+      f = kept;
+    }
+    r = pipeline.process(f);
+    if (k == 29) {
+      EXPECT_EQ(r.state, PipelineState::kInitialising);
+      EXPECT_EQ(r.status.rfind("target seen, initialising: waiting for camera motion", 0), 0u)
+          << r.status;
+      EXPECT_EQ(r.start_target_unseen_s, 0.0);
+    }
+  }
+  EXPECT_EQ(r.state, PipelineState::kInitialising);
+  EXPECT_NE(r.status.find("the start-up target is out of view"), std::string::npos) << r.status;
+  EXPECT_NEAR(r.start_target_unseen_s, 120 / 30.0, 0.05);
+  EXPECT_NEAR(r.start_wait_s, 149 / 30.0, 0.05);
+  // A reset forgets the wait.
+  pipeline.reset();
+  TrackFrame f = world.frame(0.0);
+  r = pipeline.process(f);
+  EXPECT_EQ(r.start_wait_s, 0.0);
+}
+
+// A reloaded tracker numbers its tracks from 1 again: its points are none of the map's,
+// whose landmarks those ids name (hostile try: "lost" for the rest of the bag). Tracks that
+// are all new with new, larger ids (everything lost and found again) are no restart.
+TEST(PlanePipeline, ATrackerThatStartedOverStartsTheMapOver) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k < 90; ++k) r = pipeline.process(world.frame(k / 30.0));
+  ASSERT_TRUE(r.pose) << r.status;
+  TrackFrame later = world.frame(90 / 30.0);  // all new, ids above the old: no restart
+  for (auto& id : later.ids) id += 100000;
+  r = pipeline.process(later);
+  EXPECT_FALSE(r.was_reset);
+  EXPECT_FALSE(r.tracker_restarted);
+  TrackFrame restarted = world.frame(91 / 30.0);  // ids from 1 again
+  const std::uint64_t lowest = *std::min_element(restarted.ids.begin(), restarted.ids.end());
+  for (auto& id : restarted.ids) id = id - lowest + 1;
+  r = pipeline.process(restarted);
+  EXPECT_TRUE(r.was_reset);
+  EXPECT_TRUE(r.tracker_restarted);
+  EXPECT_FALSE(r.pose);
+  TrackFrame next = world.frame(92 / 30.0);  // the restarted tracker's next image
+  for (auto& id : next.ids) id = id - lowest + 1;
+  r = pipeline.process(next);
+  EXPECT_FALSE(r.was_reset);
+}
+
 TEST(PlanePipeline, ImagePlaneIdsAreStable) {
   const SyntheticTracks world("wheeled");
   PlanePipeline pipeline;
@@ -274,8 +346,8 @@ TEST(PlanePipeline, PureRotationIsReportedAndNotSegmented) {
   int segmented_early = 0, rotation_late = 0;
   for (int k = 1; k <= 80; ++k) {
     const double yaw = 0.5 * k * CV_PI / 180;
-    const cv::Matx33d turn(std::cos(yaw), -std::sin(yaw), 0, std::sin(yaw), std::cos(yaw), 0, 0,
-                           0, 1);
+    const cv::Matx33d turn(std::cos(yaw), -std::sin(yaw), 0, std::sin(yaw), std::cos(yaw), 0, 0, 0,
+                           1);
     const Pose pose{turn * stop.R, stop.t};
     r = pipeline.process(world.frameAt(pose, 1002.0 + k / 30.0));
     if (k <= 10 && !r.planes.empty() && r.parallax_px >= pipeline.params().min_parallax_px)
@@ -315,7 +387,6 @@ TEST(PlanePipeline, SlowMotionComparesWithAnOlderKeyframe) {
   EXPECT_GE(measured, 100);
   EXPECT_GE(far_back, measured * 9 / 10);
 }
-
 
 // camera_height on the humanoid (no floor in the image: an up-to-scale start, checked by
 // its floor landmarks later): the planes seen while the start was being checked reach

@@ -2,40 +2,39 @@
 // checks planes, markers, map points, tf and the debug image.
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
-#include <rosgraph_msgs/Log.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include <dynamic_reconfigure/Reconfigure.h>
-#include <geometry_msgs/PoseStamped.h>
-#include <std_srvs/Empty.h>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <sstream>
 #include <map>
 #include <optional>
+#include <sstream>
 
 #include "mono_plane_detection/PlaneArray.h"
-#include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/SaveMap.h"
+#include "mono_plane_detection/Tracks.h"
 #include "mono_plane_detection/geometry/plane_fit.h"
 #include "mono_plane_detection/ros/map_frame.h"
 #include "mono_plane_detection/ros/pose_msg.h"
-#include "support/temp_path.h"
 #include "support/diagnostics_probe.h"
 #include "support/synthetic_tracks.h"
+#include "support/temp_path.h"
 #include "support/test_timeouts.h"
 
 using namespace mono_plane_detection;
@@ -45,8 +44,7 @@ namespace {
 // Both ends linked: an answer published before our subscriber is connected is lost (seen
 // once with both cores busy: the first image "not answered").
 ::testing::AssertionResult linked(const ros::Publisher& tracks, const ros::Subscriber& answers) {
-  spinUntil([&] { return tracks.getNumSubscribers() > 0 && answers.getNumPublishers() > 0; },
-            10.0);
+  spinUntil([&] { return tracks.getNumSubscribers() > 0 && answers.getNumPublishers() > 0; }, 10.0);
   if (tracks.getNumSubscribers() == 0)
     return ::testing::AssertionFailure() << tracks.getTopic() << ": nobody listens";
   if (answers.getNumPublishers() == 0)
@@ -113,8 +111,7 @@ class PlaneNodeletTest : public ::testing::Test {
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 2, true);
     image_pub_ = nh_.advertise<sensor_msgs::Image>("image", 20);
     planes_sub_ = nh_.subscribe("planes", 50, &PlaneNodeletTest::onPlanes, this);
-    image_planes_sub_ =
-        nh_.subscribe("image_planes", 50, &PlaneNodeletTest::onImagePlanes, this);
+    image_planes_sub_ = nh_.subscribe("image_planes", 50, &PlaneNodeletTest::onImagePlanes, this);
     no_info_sub_ = nh_.subscribe("planes_no_info", 50, &PlaneNodeletTest::onNoInfo, this);
     // Every topic is a connection of its own: an answer published before its subscriber
     // is linked is lost (A_ missed its image_planes once in CI).
@@ -468,8 +465,8 @@ TEST_F(PlaneNodeletTest, I_OdometryFromTf) {
   tf2_ros::TransformListener listener(buffer);
   ASSERT_TRUE(linked(other.tracks, other.planes));
   std::vector<std::string> logged;  // INFO lines on /rosout (only this instance gets tracks)
-  ros::Subscriber rosout = nh_.subscribe<rosgraph_msgs::Log>(
-      "/rosout", 200, [&](const rosgraph_msgs::LogConstPtr& m) {
+  ros::Subscriber rosout =
+      nh_.subscribe<rosgraph_msgs::Log>("/rosout", 200, [&](const rosgraph_msgs::LogConstPtr& m) {
         if (m->level == rosgraph_msgs::Log::INFO) logged.push_back(m->msg);
       });
   // The manager's publisher besides this node's own.
@@ -554,7 +551,7 @@ TEST_F(PlaneNodeletTest, I2_OdometrySourceWithoutTargetAndATfThatStops) {
     const double t = k / 30.0;
     TrackFrame f = world_->frame(t);
     for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;  // no target
-    f.stamp += 3500;  // its own time line
+    f.stamp += 3500;                                                       // its own time line
     TracksPtr msg = toTracks(f);
     msg->header.frame_id = "camera_optical_source";
     tracks.publish(msg);
@@ -689,7 +686,7 @@ TEST_F(PlaneNodeletTest, I3_OdometryLaggingBeyondTheWaitIsNotWaitedForAtEveryIma
     if (k < images) {
       TrackFrame f = world_->frame(k / 30.0);
       for (size_t i = 0; i < f.ids.size(); ++i) f.target_corner[i] = false;  // no target
-      f.stamp += 5500;  // its own time line
+      f.stamp += 5500;                                                       // its own time line
       TracksPtr msg = toTracks(f);
       msg->header.frame_id = "camera_optical_late";
       tracks.publish(msg);
@@ -735,7 +732,6 @@ TEST_F(PlaneNodeletTest, J_RestartWhileTracksFlow) {
   ASSERT_TRUE(later);
   EXPECT_TRUE(later->metric) << later->status;
 }
-
 
 // Issue 15, cases 2-4: camera_info with D: [] (reshape threw), the same K with 5 then 8
 // then 14 coefficients (cv::norm asserted), D of a length OpenCV does not take (accepted,
@@ -987,7 +983,16 @@ TEST_F(PlaneNodeletTest, N_SaveMapAndReset) {
   ASSERT_TRUE(ros::service::call("/plane_detector/save_map", nowhere));
   EXPECT_FALSE(nowhere.response.success);
 
+  int cleared = 0;  // DELETEALL markers heard: rviz drops the old map's planes at the reset
+  ros::Subscriber markers = nh_.subscribe<visualization_msgs::MarkerArray>(
+      "plane_markers", 10, [&](const visualization_msgs::MarkerArrayConstPtr& m) {
+        for (const auto& marker : m->markers)
+          cleared += marker.action == visualization_msgs::Marker::DELETEALL;
+      });
+  spinUntil([&] { return markers.getNumPublishers() > 0; }, 5.0);
   ASSERT_TRUE(ros::service::call("/plane_detector/reset", reset));
+  spinUntil([&] { return cleared > 0; }, 2.0);
+  EXPECT_EQ(cleared, 1) << "no DELETEALL on ~reset without further tracks";
   {
     // Before the next tracks (a paused robot): the status is the reset's, not the old map's
     // (hostile try: "tracking (landmarks)" and its tf link stayed).
@@ -1153,7 +1158,8 @@ TEST_F(PlaneNodeletTest, P2_AMetricSourceThatCannotStartIsAnError) {
   DiagnosticsProbe diagnostics(nh_, "plane_detector_misconfigured: planes");
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::ERROR) << diagnostics.message();
-  EXPECT_NE(diagnostics.message().find("metric_source odometry needs odom_frame"), std::string::npos)
+  EXPECT_NE(diagnostics.message().find("metric_source odometry needs odom_frame"),
+            std::string::npos)
       << diagnostics.message();
   // The healthy instance has no configuration problem.
   DiagnosticsProbe healthy(nh_, "plane_detector: planes");

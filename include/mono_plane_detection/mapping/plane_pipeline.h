@@ -12,10 +12,10 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/mapping/odometry_check.h"
 #include "mono_plane_detection/mapping/plane_map.h"
 #include "mono_plane_detection/mapping/pose_estimator.h"
+#include "mono_plane_detection/planes/homography_voting.h"
 #include "mono_plane_detection/tracking/stream_gaps.h"
 #include "mono_plane_detection/tracking/target_detector.h"
 #include "mono_plane_detection/tracking/track_frame.h"
@@ -78,13 +78,21 @@ enum class PipelineState { kNoCamera, kWaitingForTarget, kInitialising, kLost, k
 
 struct PipelineResult {
   PipelineState state = PipelineState::kNoCamera;
-  std::string status;                // for people: "waiting for target", ...
-  bool was_reset = false;            // time went backwards: everything started again
-  bool tracking_loss = false;        // the pause since the last image exceeded max_gap_s
-  double pause_s = 0;                // with tracking_loss: that pause, s
+  std::string status;      // for people: "waiting for target", ...
+  bool was_reset = false;  // time went backwards: everything started again
+  // ...or the tracker started over: its ids (never reused by one tracker) began again
+  // below those seen, none of the last image's left (a reloaded or respawned tracker
+  // nodelet: its ids 1, 2, ... met the old map's landmarks, "lost" for good).
+  bool tracker_restarted = false;
+  bool tracking_loss = false;  // the pause since the last image exceeded max_gap_s
+  double pause_s = 0;          // with tracking_loss: that pause, s
   // Images missing from the stream just before this one, by the stamps' gaps (GapCounter):
   // dropped by the tracker, or frames this stage's caller never got.
   long missing_images = 0;
+  // kInitialising (the target start): how long it has waited, and since the target's four
+  // corners were last tracked, s of stamps (PoseEstimator::startWaitS).
+  double start_wait_s = 0;
+  double start_target_unseen_s = 0;
   std::optional<PoseEstimate> pose;  // this image's camera in the map
   std::vector<ImagePlane> planes;    // largest first
   double reference_stamp = -1;       // image the homographies start from, -1 none
@@ -96,8 +104,8 @@ struct PipelineResult {
   bool pure_rotation = false;
   // With odometry poses here and at the reference: whether they explain the tracks.
   OdometryCheck odometry_check;
-  TrackPairs pairs;             // reference/current pixels the planes were found in
-  PlaneSegmentation segmentation;    // over `pairs`
+  TrackPairs pairs;                // reference/current pixels the planes were found in
+  PlaneSegmentation segmentation;  // over `pairs`
 };
 
 class PlanePipeline {
@@ -148,8 +156,7 @@ class PlanePipeline {
   };
   // The reference for `frame`: index into history_, its parallax (-1: not measured),
   // -1 index when every image within reach is a rotation away.
-  std::pair<int, double> chooseReference(const TrackFrame& frame,
-                                         const std::optional<Pose>& pose,
+  std::pair<int, double> chooseReference(const TrackFrame& frame, const std::optional<Pose>& pose,
                                          const std::vector<cv::Point2d>& normalized) const;
   std::vector<cv::Point2d> normalize(const std::vector<cv::Point2d>& pixels) const;
   // The map's observations of these image planes from this pose (landmarks with sigmas).
@@ -164,7 +171,8 @@ class PlanePipeline {
   std::deque<PendingView> pending_;  // the oldest dropped first
 
   std::deque<PastFrame> history_;
-  GapCounter stream_;  // the tracks' rhythm: what counts as a pause
+  std::uint64_t newest_id_ = 0;  // the largest track id seen since the last reset
+  GapCounter stream_;            // the tracks' rhythm: what counts as a pause
   std::vector<ImagePlane> previous_planes_;
   int next_image_id_ = 1;
   // motion_plane_images: per image plane id, the images each track was a member in and

@@ -125,6 +125,13 @@ class PoseEstimator {
   // True once the two-view start has placed the first landmarks (before that the pose
   // comes from the target alone and nothing is triangulated).
   bool initialised() const { return initialised_; }
+  // The target start before it succeeds (not initialised, the target counting): how long
+  // it has waited since the target was first seen, and since all four of its corners were
+  // last tracked, s of stamps (0 otherwise). The start needs the target in two views with
+  // parallax: a target that left the view makes it wait for ever (hostile try: "waiting
+  // for camera motion" for 550 images while the camera travelled 3 m, status OK).
+  double startWaitS() const { return start_wait_s_; }
+  double startTargetUnseenS() const { return start_target_unseen_s_; }
   const std::unordered_map<std::uint64_t, Landmark>& landmarks() const { return landmarks_; }
   // Triangulated (or fixed) landmark position of a track, if any (not provisional).
   std::optional<cv::Vec3d> landmarkPosition(std::uint64_t id) const;
@@ -135,10 +142,10 @@ class PoseEstimator {
   const std::vector<double>& bundleTimesMs() const { return bundle_times_ms_; }
   // What the local bundle adjustment refused or flagged, since the start.
   struct BundleCounts {
-    int refused = 0;             // runs whose input was refused (last_reason)
+    int refused = 0;  // runs whose input was refused (last_reason)
     std::string last_reason;
-    int behind_after = 0;        // observations behind their camera after a run (outliers)
-    int refused_behind = 0;      // steps refused: they put a point behind a camera
+    int behind_after = 0;    // observations behind their camera after a run (outliers)
+    int refused_behind = 0;  // steps refused: they put a point behind a camera
   };
   const BundleCounts& bundleCounts() const { return bundle_counts_; }
 
@@ -171,8 +178,8 @@ class PoseEstimator {
   // written back (poses, landmarks; observations it disagrees with dropped or restarted).
   struct WindowProblem {
     BundleProblem problem;
-    std::vector<std::uint64_t> point_ids;  // the landmark of each problem point
-    size_t keyframe_observations = 0;      // the first ones: the keyframes' (then anchors')
+    std::vector<std::uint64_t> point_ids;        // the landmark of each problem point
+    size_t keyframe_observations = 0;            // the first ones: the keyframes' (then anchors')
     size_t first_in_window = 0, first_free = 0;  // keyframe indices
     std::unordered_map<std::int64_t, int> keyframe_of_image;
   };
@@ -224,6 +231,8 @@ class PoseEstimator {
   std::optional<Pose> map_from_odom_;
   bool vision_only_ = false;  // odometry map, odometry missing for this image
   bool initialised_ = false;
+  double start_first_stamp_ = -1, start_target_stamp_ = -1;  // (startWaitS)
+  double start_wait_s_ = 0, start_target_unseen_s_ = 0;
   std::optional<FirstView> first_view_;
   MetricSource metric_ = MetricSource::kNone;
   std::string floor_reason_;  // why the camera_height start has not happened yet
