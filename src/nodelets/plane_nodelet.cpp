@@ -25,6 +25,7 @@
 #include <memory>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
+#include <iomanip>
 #include <sstream>
 
 #include "callback_guard.h"
@@ -61,7 +62,7 @@ std::string sizeText(const cv::Size& size) {
 
 std::string secondsText(double s) {
   std::ostringstream text;
-  text << s << " s";
+  text << std::setprecision(3) << s << " s";  // 0.25 s, 2.53 s, 10.5 s, 150 s
   return text.str();
 }
 
