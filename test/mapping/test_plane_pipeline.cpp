@@ -134,19 +134,7 @@ TEST(PlanePipeline, AStartWhoseTargetLeftTheViewSaysSo) {
     // Still for 1 s (the first image's view, again and again): no parallax.
     TrackFrame f = world.frame(k < 30 ? 0.0 : k / 30.0);
     f.stamp = 1000 + k / 30.0;
-    if (k >= 30) {  // then the target's corners are gone
-      TrackFrame kept = f;
-      kept.ids.clear();
-      kept.pixels.clear();
-      kept.target_corner.clear();
-      for (size_t i = 0; i < f.ids.size(); ++i)
-        if (!f.target_corner[i]) {
-          kept.ids.push_back(f.ids[i]);
-          kept.pixels.push_back(f.pixels[i]);
-          kept.target_corner.push_back(false);
-        }
-      f = kept;
-    }
+    if (k >= 30) f = withoutTarget(f);  // then the target's corners are gone
     r = pipeline.process(f);
     if (k == 29) {
       EXPECT_EQ(r.state, PipelineState::kInitialising);
