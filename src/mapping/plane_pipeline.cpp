@@ -126,10 +126,12 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   if (!frame.ids.empty()) {
     const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
     if (!history_.empty() && newest < newest_id_) {
-      const std::vector<std::uint64_t>& last = history_.back().frame.ids;
-      const bool none_left = std::none_of(frame.ids.begin(), frame.ids.end(), [&](auto id) {
-        return std::find(last.begin(), last.end(), id) != last.end();
-      });
+      // (Checked whenever the newest track is gone, not only at restarts: a set, not a
+      // search of the last image per id.)
+      const std::vector<std::uint64_t>& last_ids = history_.back().frame.ids;
+      const std::unordered_set<std::uint64_t> last(last_ids.begin(), last_ids.end());
+      const bool none_left = std::none_of(frame.ids.begin(), frame.ids.end(),
+                                          [&](std::uint64_t id) { return last.count(id) > 0; });
       if (none_left) {
         reset();
         result.was_reset = result.tracker_restarted = true;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "callback_guard.h"
@@ -44,8 +45,9 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
     const ros::WallTime now = ros::WallTime::now();
     trim(now);
     // Until a whole window has passed since the first message, rate over what there is.
-    const double span =
-        started_.isZero() ? window_s_ : std::min(window_s_, std::max((now - started_).toSec(), 1e-3));
+    const double span = started_.isZero()
+                            ? window_s_
+                            : std::min(window_s_, std::max((now - started_).toSec(), 1e-3));
     const double hz = static_cast<double>(ticks_.size()) / span;
     if (idle_)
       status.summary(diagnostic_msgs::DiagnosticStatus::OK,
@@ -88,6 +90,13 @@ class StatusProblems {
  public:
   void add(unsigned char level, const std::string& key, const std::string& text) {
     problems_.push_back({level, key, text});
+  }
+  // (key, text) pairs as WARNs, each key after `prefix` (StreamHealth::problems,
+  // RecentEvents::recent: both nodelets list them alike).
+  void addWarnings(const std::vector<std::pair<std::string, std::string>>& warnings,
+                   const std::string& prefix = "") {
+    for (const auto& [key, text] : warnings)
+      add(diagnostic_msgs::DiagnosticStatus::WARN, prefix + key, text);
   }
 
   void report(diagnostic_updater::DiagnosticStatusWrapper& status,

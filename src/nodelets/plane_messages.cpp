@@ -69,8 +69,8 @@ std::string odometryError(const Pose& odom, const std::optional<Pose>& previous,
     const double jump = cv::norm(odom.t - previous->t);
     if (!(jump <= max_jump_m)) {
       std::ostringstream why;
-      why << "it moved " << jump << " m since the previous tracks, more than max_odom_jump_m = "
-          << max_jump_m;
+      why << "it moved " << jump
+          << " m since the previous tracks, more than max_odom_jump_m = " << max_jump_m;
       return why.str();
     }
   }
@@ -196,6 +196,13 @@ std::string planesYaml(const PlaneArray& planes) {
       out << "      - [" << v.x << ", " << v.y << ", " << v.z << "]\n";
   }
   return out.str();
+}
+
+visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header) {
+  visualization_msgs::Marker clear;
+  clear.header = header;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  return clear;
 }
 
 visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,

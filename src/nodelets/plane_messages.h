@@ -52,6 +52,9 @@ std::string planesYaml(const PlaneArray& planes);
 visualization_msgs::MarkerArrayPtr toMarkers(const std_msgs::Header& header, const PlaneMap& map,
                                              std::set<int>& shown);
 
+// One DELETEALL marker: rviz drops every plane of the map it had.
+visualization_msgs::Marker deleteAllMarker(const std_msgs::Header& header);
+
 // Triangulated landmarks (x, y, z, rgb), coloured by the map plane they are on.
 sensor_msgs::PointCloud2Ptr toCloud(const std_msgs::Header& header, const PoseEstimator& pose,
                                     const PlaneMap& map);

@@ -21,11 +21,11 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
-#include <iomanip>
 #include <sstream>
 
 #include "callback_guard.h"
@@ -347,14 +347,6 @@ class PlaneNodelet : public nodelet::Nodelet {
       tf_edge_.clear();
       map_frame_shared_.clear();
       ++resets_;
-      // rviz drops the old map's planes now, not when a new map first has markers
-      // (hostile try: they stayed 33 s and more).
-      visualization_msgs::MarkerArrayPtr clear(new visualization_msgs::MarkerArray);
-      clear->markers.emplace_back();
-      clear->markers.back().header.frame_id = map_frame_;
-      clear->markers.back().header.stamp = ros::Time::now();
-      clear->markers.back().action = visualization_msgs::Marker::DELETEALL;
-      markers_pub_.publish(clear);
       NODELET_INFO("reset: the map and the camera pose start over");
       done = true;
     });
@@ -366,7 +358,14 @@ class PlaneNodelet : public nodelet::Nodelet {
   // another camera starts it again.
   void mapStartedOver(bool keep_target_wait = false) {
     markers_shown_.clear();
-    reset_markers_ = true;
+    // rviz drops the old map's planes now, not when a new map first has markers (hostile
+    // try: after ~reset they stayed 33 s and more).
+    std_msgs::Header header;
+    header.frame_id = map_frame_;
+    header.stamp = ros::Time::now();
+    visualization_msgs::MarkerArrayPtr clear(new visualization_msgs::MarkerArray);
+    clear->markers.push_back(deleteAllMarker(header));
+    markers_pub_.publish(clear);
     if (!keep_target_wait) target_wait_.reset();
   }
 
@@ -867,10 +866,7 @@ class PlaneNodelet : public nodelet::Nodelet {
         if (markers_pub_.getNumSubscribers() > 0 || reset_markers_) {
           markers = toMarkers(map_header, pipeline_->map(), markers_shown_);
           if (reset_markers_) {
-            visualization_msgs::Marker clear;
-            clear.header = map_header;
-            clear.action = visualization_msgs::Marker::DELETEALL;
-            markers->markers.insert(markers->markers.begin(), clear);
+            markers->markers.insert(markers->markers.begin(), deleteAllMarker(map_header));
             reset_markers_ = false;
           }
         }
@@ -983,12 +979,11 @@ class PlaneNodelet : public nodelet::Nodelet {
                        "sideways (or towards it) while it sees the target; turning on the "
                        "spot gives no parallax");
     // The stream lately (as the tracker's).
-    for (const auto& [key, text] : stream_health_.problems(
-             "tracks",
-             "images the tracker never got, or this nodelet's queue overflowed: the map is "
-             "slower than the stream, e.g. under CPU load",
-             "the map starting over", "tracks"))
-      problems.add(DiagnosticStatus::WARN, key, text);
+    problems.addWarnings(stream_health_.problems(
+        "tracks",
+        "images the tracker never got, or this nodelet's queue overflowed: the map is "
+        "slower than the stream, e.g. under CPU load",
+        "the map starting over", "tracks"));
     // Other refused values were replaced by their defaults: after the present problems.
     if (blocked.empty() && (!start_errors_.empty() || !reconfigure_errors_.empty())) {
       std::vector<std::string> all = start_errors_;
@@ -996,8 +991,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(all));
     }
     if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
-    for (const auto& [kind, text] : problems_.recent(kRecentS))  // the totals stay below
-      problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
+    problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");  // the totals stay below
     problems.report(status, status_.empty() ? "no tracks yet" : status_);
     // The state also when a problem is the summary.
     status.add("state", status_.empty() ? "no tracks yet" : status_);
@@ -1087,8 +1081,9 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
-  // The next markers begin with DELETEALL: true at start too, so a reloaded or respawned
-  // nodelet clears the old one's planes from rviz (hostile try: they stayed beside the new).
+  // The first markers of this nodelet begin with DELETEALL: a reloaded or respawned one
+  // clears the old one's planes from rviz (hostile try: they stayed beside the new; a
+  // DELETEALL at load would reach no rviz not yet connected). Start-overs publish their own.
   bool reset_markers_ = true;
   PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
   std::string status_;

@@ -10,8 +10,8 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <pluginlib/class_list_macros.hpp>
+#include <sstream>
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
@@ -32,7 +32,8 @@ class TrackerNodelet : public nodelet::Nodelet {
 
  private:
   void onInit() override {
-    initOrAbandon(getName(), [this] { init(); }, [this] { abandonInit(); });
+    initOrAbandon(
+        getName(), [this] { init(); }, [this] { abandonInit(); });
   }
 
   void abandonInit() {
@@ -91,8 +92,9 @@ class TrackerNodelet : public nodelet::Nodelet {
   }
 
   void subscribe() {
-    image_sub_ = it_->subscribe("image", 5, guard_.message("image", this, &TrackerNodelet::imageCallback),
-                                ros::VoidPtr(), image_transport::TransportHints(front_.params().image_transport));
+    image_sub_ = it_->subscribe(
+        "image", 5, guard_.message("image", this, &TrackerNodelet::imageCallback), ros::VoidPtr(),
+        image_transport::TransportHints(front_.params().image_transport));
     info_sub_ = getNodeHandle().subscribe<sensor_msgs::CameraInfo>(
         "camera_info", 1, guard_.message("camera_info", this, &TrackerNodelet::infoCallback));
     std::lock_guard<std::mutex> state_lock(state_mutex_);
@@ -104,8 +106,8 @@ class TrackerNodelet : public nodelet::Nodelet {
   void infoCallback(const sensor_msgs::CameraInfoConstPtr& info) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     const std::string error = front_.setCameraInfo(*info);
-    if (!error.empty() && problems_.note("camera_info " + reasonKind(error),
-                                         "camera_info unusable: " + error, 10.0))
+    if (!error.empty() &&
+        problems_.note("camera_info " + reasonKind(error), "camera_info unusable: " + error, 10.0))
       NODELET_WARN("camera_info unusable (%s): ignored, %s", error.c_str(),
                    front_.hasCameraInfo() ? "the last usable one stays in use"
                                           : "tracking goes on in pixels");
@@ -149,11 +151,12 @@ class TrackerNodelet : public nodelet::Nodelet {
   // One throttle per kind of event, so that one kind never hides another.
   void warn(const LogEvent& event) {
     // A camera switch is also a problem of the stream for diagnostics (while recent).
-    if (event.kind == "camera switch") problems_.note("camera switch", "image stream mixes cameras");
+    if (event.kind == "camera switch")
+      problems_.note("camera switch", "image stream mixes cameras");
     if (event.kind == "backwards") stream_health_.wentBackwards();
-    if (logged_.note(event.kind, event.text, 5.0, event.burst)) NODELET_WARN("%s", event.text.c_str());
+    if (logged_.note(event.kind, event.text, 5.0, event.burst))
+      NODELET_WARN("%s", event.text.c_str());
   }
-
 
   void imageCallback(const sensor_msgs::ImageConstPtr& msg) {
     diagnostics_.tick();
@@ -175,8 +178,8 @@ class TrackerNodelet : public nodelet::Nodelet {
       // without /clock, and goes back in a bag loop (it was never said then; hostile try).
       if (out.tracks && front_.params().detect_target && !front_.targetFound() &&
           !front_.targetOverdue() && logged_.note("target wait", "", 10.0))
-        NODELET_INFO("waiting for the start-up target (%s): %s",
-                     front_.targetDescription().c_str(), front_.targetReason().c_str());
+        NODELET_INFO("waiting for the start-up target (%s): %s", front_.targetDescription().c_str(),
+                     front_.targetReason().c_str());
       if (!out.tracks) {
         // One throttle per reason: each kind of bad image is named at least once.
         if (problems_.note(reasonKind(out.dropped), "image dropped: " + out.dropped)) {
@@ -189,8 +192,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       }
     }
     for (const std::string& info : out.infos) NODELET_INFO("%s", info.c_str());
-    out.tracks->processing_ms =
-        static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
+    out.tracks->processing_ms = static_cast<float>((ros::WallTime::now() - started).toSec() * 1e3);
     tracks_pub_.publish(out.tracks);  // shared pointer: no copy inside one manager
 
     if (debug_pub_.getNumSubscribers() > 0) {
@@ -249,16 +251,14 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (no_target)
       problems.add(DiagnosticStatus::WARN, "start-up target",
                    "no start-up target: " + front_.targetReason());
-    for (const auto& [key, text] : stream_health_.problems(
-             "images",
-             "the subscriber queue overflowed: tracking is slower than the stream, e.g. under "
-             "CPU load; or the driver or the network dropped them",
-             "tracking starting over", "image"))
-      problems.add(DiagnosticStatus::WARN, key, text);
+    problems.addWarnings(stream_health_.problems(
+        "images",
+        "the subscriber queue overflowed: tracking is slower than the stream, e.g. under "
+        "CPU load; or the driver or the network dropped them",
+        "tracking starting over", "image"));
     if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
       problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
-    for (const auto& [kind, text] : problems_.recent(kRecentS))
-      problems.add(DiagnosticStatus::WARN, "last 10 s, " + kind, text);
+    problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");
     problems.report(status, "tracking");
     status.add("points tracked", c.tracked_now);
     status.add("points lost (total)", c.lost);
@@ -268,11 +268,12 @@ class TrackerNodelet : public nodelet::Nodelet {
     status.add("camera switches (total)", c.camera_switches);
     status.add("exceptions caught (total)", exceptions);
     if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera_info", !front_.hasCameraInfo()          ? "none or unusable"
-                              : info_mismatch.empty()            ? "ok"
-                              : front_.hasCalibrationForImages() ? "the last of the images' size "
-                                                                   "(the newest is for another size)"
-                                                                 : "for another image size: not used");
+    status.add("camera_info", !front_.hasCameraInfo() ? "none or unusable"
+                              : info_mismatch.empty() ? "ok"
+                              : front_.hasCalibrationForImages()
+                                  ? "the last of the images' size "
+                                    "(the newest is for another size)"
+                                  : "for another image size: not used");
     status.add("camera model", front_.cameraModel());
     status.add("images with camera_info of another size (total)", c.info_size_mismatch);
     status.add("images with camera_info of another frame_id (total)", c.info_frame_mismatch);
@@ -288,8 +289,8 @@ class TrackerNodelet : public nodelet::Nodelet {
       const TargetStartup& t = front_.targetStartup();
       std::ostringstream moved;
       moved << t.reanchoredImages() << " of " << t.followedImages()
-            << " images with its four corners tracked (last move "
-            << std::fixed << std::setprecision(2) << t.lastReanchorShiftPx() << " px)";
+            << " images with its four corners tracked (last move " << std::fixed
+            << std::setprecision(2) << t.lastReanchorShiftPx() << " px)";
       status.add("target: corners re-detected", moved.str());
     }
     if (front_.params().detect_target && !front_.targetFound()) {
@@ -315,17 +316,17 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::WallTime subscribed_at_;              // zero while not subscribed (lazy, nobody listens)
   std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
-  std::vector<std::string> config_errors_;  // parameters refused at start (set in init)
-  StreamHealth stream_health_;  // images missing, time going back (last 10 s)
+  std::vector<std::string> config_errors_;   // parameters refused at start (set in init)
+  StreamHealth stream_health_;               // images missing, time going back (last 10 s)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
 
   std::mutex connect_mutex_;  // subscription changes
   std::mutex state_mutex_;    // front_ and the log throttles
 
-  RecentEvents problems_;  // dropped images, unusable camera_info
+  RecentEvents problems_;                   // dropped images, unusable camera_info
   static constexpr double kRecentS = 10.0;  // a WARN in diagnostics lasts this long
-  RecentEvents logged_;    // the front end's warnings: one throttle per kind
+  RecentEvents logged_;                     // the front end's warnings: one throttle per kind
 
   NodeletDiagnostics diagnostics_;
 };

@@ -212,7 +212,7 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
   EXPECT_EQ(camera.size, cv::Size(320, 240));
   EXPECT_EQ(camera.K(0, 2), 270);  // (640 - 100) / 2
   EXPECT_EQ(camera.K(1, 2), 215);  // (480 - 50) / 2
-  info.D.clear();  // no distortion: the same K (it was taken unbinned)
+  info.D.clear();                  // no distortion: the same K (it was taken unbinned)
   ASSERT_EQ(intrinsicsFromCameraInfo(info, false, camera), "");
   EXPECT_EQ(camera.K(0, 2), 270);
   EXPECT_TRUE(camera.D.empty());
@@ -320,7 +320,7 @@ TEST(CalibrationHolder, TheLastCameraInfoOfTheImagesSizeIsUsed) {
   used = holder.forImages({640, 480}, mismatch);
   ASSERT_NE(used, nullptr);
   EXPECT_EQ(used->K(0, 0), 510);
-  EXPECT_EQ(holder.mismatch({0, 0}), "");  // no images yet: nothing to compare
+  EXPECT_EQ(holder.mismatch({0, 0}), "");      // no images yet: nothing to compare
   ASSERT_NE(holder.heldFor({0, 0}), nullptr);  // and the last camera_info is the one held
   EXPECT_EQ(holder.heldFor({0, 0})->K(0, 0), 510);
   EXPECT_EQ(CalibrationHolder().heldFor({0, 0}), nullptr);
@@ -368,6 +368,26 @@ TEST(StatusProblems, EveryProblemHasItsKeyAndTheWorstIsTheSummary) {
   EXPECT_EQ(fine.level, diagnostic_msgs::DiagnosticStatus::OK);
   EXPECT_EQ(fine.message, "mapping");
   EXPECT_EQ(value(fine, "problems now"), "0");
+  // Lists of warnings (recent events, the stream's health) with their keys' prefix.
+  StatusProblems listed;
+  listed.addWarnings({{"images missing", "12 of 300"}, {"time", "went back 3 times"}});
+  listed.addWarnings({{"camera_info rejected", "K is zero"}}, "last 10 s, ");
+  diagnostic_updater::DiagnosticStatusWrapper warned;
+  listed.report(warned, "tracking");
+  EXPECT_EQ(warned.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(value(warned, "problems now"), "3");
+  EXPECT_EQ(value(warned, "problem: time"), "WARN: went back 3 times");
+  EXPECT_EQ(value(warned, "problem: last 10 s, camera_info rejected"), "WARN: K is zero");
+}
+
+TEST(PlaneMessages, DeleteAllMarkerClearsEveryPlaneInTheGivenFrame) {
+  std_msgs::Header header;
+  header.frame_id = "robot1/plane_map";
+  header.stamp = ros::Time(12.5);
+  const visualization_msgs::Marker clear = deleteAllMarker(header);
+  EXPECT_EQ(clear.action, visualization_msgs::Marker::DELETEALL);
+  EXPECT_EQ(clear.header.frame_id, "robot1/plane_map");
+  EXPECT_EQ(clear.header.stamp, ros::Time(12.5));
 }
 
 TEST(WindowCounts, SumsTheLastWindowOnly) {
@@ -388,7 +408,8 @@ TEST(WindowCounts, AMissingShareOverATenthIsAProblem) {
   EXPECT_EQ(missingShareText(270, 30, "images", "why"), "");  // exactly a tenth
   EXPECT_EQ(missingShareText(269, 31, "images", "queue full"),
             "31 of 300 images missing in the last 10 s (queue full)");
-  EXPECT_EQ(missingShareText(0, 3, "tracks", "why"), "3 of 3 tracks missing in the last 10 s (why)");
+  EXPECT_EQ(missingShareText(0, 3, "tracks", "why"),
+            "3 of 3 tracks missing in the last 10 s (why)");
 }
 
 TEST(StreamHealth, MissingShareAndAFloodOfTimeJumps) {
@@ -583,9 +604,9 @@ TEST(TrackerFrontEnd, BadMessagesOfAnotherCameraOrClockLeaveTheRhythm) {
     ASSERT_TRUE(out.tracks);
     for (const LogEvent& e : out.warnings) EXPECT_NE(e.kind, "gap") << k << ": " << e.text;
     if (k == 10) ids_at_10 = out.tracks->id;
-    bad(ros::Time(100, nsecs + 3000000), "depth");                // another camera
-    if (k % 5 == 0) bad(ros::Time(95, nsecs), "camera");          // 5 s early
-    if (k % 9 == 0) bad(ros::Time(4000000000u, 0), "camera");     // a clock far off
+    bad(ros::Time(100, nsecs + 3000000), "depth");             // another camera
+    if (k % 5 == 0) bad(ros::Time(95, nsecs), "camera");       // 5 s early
+    if (k % 9 == 0) bad(ros::Time(4000000000u, 0), "camera");  // a clock far off
   }
   EXPECT_EQ(front.counts().missing, expected_missing);
   // Still the same tracks: no restart (most of image 10's points are still there).
@@ -787,7 +808,8 @@ TEST(TrackerFrontEnd, TargetNotJudgedWithTheIntrinsicsOfAnotherImageSize) {
   TrackerNodeParams params;
   TrackerFrontEnd front(params);
   EXPECT_EQ(front.setCameraInfo(other), "");
-  for (int k = 0; k < 5 && !front.targetFound(); ++k) front.process(image(sheet, 100, k * 100000000));
+  for (int k = 0; k < 5 && !front.targetFound(); ++k)
+    front.process(image(sheet, 100, k * 100000000));
   EXPECT_TRUE(front.targetFound()) << front.targetReason();
 }
 
