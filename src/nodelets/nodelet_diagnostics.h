@@ -24,7 +24,11 @@ namespace mono_plane_detection {
 class WallRateStatus : public diagnostic_updater::DiagnosticTask {
  public:
   WallRateStatus(double min_hz, double max_hz, double window_s = 5.0)
-      : DiagnosticTask("input rate"), min_hz_(min_hz), max_hz_(max_hz), window_s_(window_s) {}
+      : DiagnosticTask("input rate"),
+        min_hz_(min_hz),
+        max_hz_(max_hz),
+        window_s_(window_s),
+        waiting_since_(ros::WallTime::now()) {}
 
   void tick(const ros::WallTime& now = ros::WallTime::now()) {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -35,15 +39,27 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
   }
 
   // A lazy nodelet nobody listens to subscribes to nothing: no input is then expected.
-  void setIdle(bool idle) {
+  // Once subscribed again, the rate counts afresh and a window passes before its absence
+  // is a warning (a camera driver takes a moment to send its first image).
+  void setIdle(bool idle, const ros::WallTime& now = ros::WallTime::now()) {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (idle_ && !idle) {
+      waiting_since_ = now;
+      started_ = ros::WallTime();
+      ticks_.clear();
+    }
     idle_ = idle;
   }
 
   void run(diagnostic_updater::DiagnosticStatusWrapper& status) override {
+    run(status, ros::WallTime::now());
+  }
+
+  void run(diagnostic_updater::DiagnosticStatusWrapper& status, const ros::WallTime& now) {
     std::lock_guard<std::mutex> lock(mutex_);
-    const ros::WallTime now = ros::WallTime::now();
     trim(now);
+    // Nothing yet since the start or the subscription, and that only for a moment.
+    const bool waiting = started_.isZero() && (now - waiting_since_).toSec() <= window_s_;
     // Until a whole window has passed since the first message, rate over what there is.
     const double span = started_.isZero()
                             ? window_s_
@@ -52,7 +68,9 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
     if (idle_)
       status.summary(diagnostic_msgs::DiagnosticStatus::OK,
                      "idle: nobody listens, nothing subscribed (lazy)");
-    else if (total_ == 0)
+    else if (waiting)
+      status.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for the first input");
+    else if (started_.isZero())
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input yet");
     else if (ticks_.empty())
       status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no input for the last window");
@@ -78,7 +96,8 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
   std::mutex mutex_;
   double min_hz_, max_hz_, window_s_;
   std::deque<ros::WallTime> ticks_;
-  ros::WallTime started_;
+  ros::WallTime waiting_since_;  // the start or the last subscription
+  ros::WallTime started_;        // the first input since then; zero: none yet
   long total_ = 0;
   bool idle_ = false;
 };

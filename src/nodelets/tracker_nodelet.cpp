@@ -232,12 +232,15 @@ class TrackerNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
     const std::string info_mismatch = front_.infoMismatch();
     if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
+    std::string ok_text = "tracking";
     if (!subscribed_at_.isZero()) {
-      // Subscribed (not idle) and no image yet or lately: nothing is tracked.
+      // Subscribed (not idle) and no image for a while, yet or lately: nothing is tracked.
+      // (Not at once: a driver takes a moment to send its first image after a subscription.)
       const ros::WallTime since = std::max(subscribed_at_, last_image_);
       const double silent_s = (now - since).toSec();
       const bool none_yet = last_image_ < subscribed_at_;
-      if (none_yet || silent_s > kNoImagesS) {
+      if (none_yet) ok_text = "waiting for the first image on " + image_topic_;
+      if (silent_s > kNoImagesS) {
         std::ostringstream why;
         why << std::fixed << std::setprecision(0) << "no images on " << image_topic_
             << (none_yet ? " yet (subscribed " : " for ") << silent_s
@@ -259,7 +262,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
       problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
     problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");
-    problems.report(status, "tracking");
+    problems.report(status, ok_text);
     status.add("points tracked", c.tracked_now);
     status.add("points lost (total)", c.lost);
     status.add("searches (total)", c.searches);
@@ -316,6 +319,7 @@ class TrackerNodelet : public nodelet::Nodelet {
   ros::WallTime subscribed_at_;              // zero while not subscribed (lazy, nobody listens)
   std::string image_topic_;                  // resolved
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
+                                             // or none since the subscription
   std::vector<std::string> config_errors_;   // parameters refused at start (set in init)
   StreamHealth stream_health_;               // images missing, time going back (last 10 s)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not

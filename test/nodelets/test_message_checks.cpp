@@ -380,6 +380,41 @@ TEST(StatusProblems, EveryProblemHasItsKeyAndTheWorstIsTheSummary) {
   EXPECT_EQ(value(warned, "problem: last 10 s, camera_info rejected"), "WARN: K is zero");
 }
 
+// The input rate: a moment's wait for the first input after the start or a (lazy)
+// subscription is not a warning; a whole window without any is; after a resubscription
+// the rate counts afresh (it said "no input for the last window", then "frequency too
+// low", for the first seconds of every resubscription).
+TEST(WallRateStatus, WaitsAWindowForTheFirstInputAndCountsAfreshOnEachSubscription) {
+  const ros::WallTime t0 = ros::WallTime::now();
+  auto at = [&](double s) { return t0 + ros::WallDuration(s); };
+  WallRateStatus rate(20, 40, 5.0);
+  auto report = [&](double s) {
+    diagnostic_updater::DiagnosticStatusWrapper status;
+    rate.run(status, at(s));
+    return std::make_pair(static_cast<int>(status.level), status.message);
+  };
+  using diagnostic_msgs::DiagnosticStatus;
+  auto is = [](int level, const std::string& text) { return std::make_pair(level, text); };
+  EXPECT_EQ(report(1), is(DiagnosticStatus::OK, "waiting for the first input"));
+  EXPECT_EQ(report(6), is(DiagnosticStatus::WARN, "no input yet"));
+  double t = 6;
+  for (; t < 11; t += 1.0 / 30) rate.tick(at(t));
+  EXPECT_EQ(report(11), is(DiagnosticStatus::OK, "desired frequency met"));
+  rate.setIdle(true, at(12));
+  EXPECT_EQ(report(13).first, static_cast<int>(DiagnosticStatus::OK));
+  EXPECT_EQ(report(13).second.rfind("idle", 0), 0u);
+  rate.setIdle(false, at(20));
+  EXPECT_EQ(report(21), is(DiagnosticStatus::OK, "waiting for the first input"));
+  for (t = 21.5; t < 22.5; t += 1.0 / 30) rate.tick(at(t));
+  EXPECT_EQ(report(22.5), is(DiagnosticStatus::OK, "desired frequency met"));
+  EXPECT_EQ(report(30), is(DiagnosticStatus::WARN, "no input for the last window"));
+  rate.setIdle(true, at(31));
+  rate.setIdle(false, at(32));
+  EXPECT_EQ(report(38), is(DiagnosticStatus::WARN, "no input yet"));
+  for (t = 38; t < 44; t += 1.0 / 5) rate.tick(at(t));  // 5 Hz for a whole window
+  EXPECT_EQ(report(44), is(DiagnosticStatus::WARN, "frequency too low"));
+}
+
 TEST(PlaneMessages, DeleteAllMarkerClearsEveryPlaneInTheGivenFrame) {
   std_msgs::Header header;
   header.frame_id = "robot1/plane_map";
