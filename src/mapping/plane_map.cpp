@@ -462,18 +462,24 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
   }
 }
 
-// A plane of points that larger confirmed planes explain adds no surface of its own: a
-// mixture of two surfaces nearly parallel to it (a wall and the shelf before it) that one
-// image's vote put together and a tilted plane fits (two parallel strips always lie on
-// one plane). It goes when fewer than min_points of its points are on no larger confirmed
-// plane and at least kStrip are on each of two of them within 45 deg of it: what is left
-// would not be taken as a plane, and it is two others' strips. A true face keeps most of
-// its points off the others (only its edges are on them), and the surfaces its edges
-// touch are across it: a floor along one wall's foot or into a corner, a ceiling along
-// two corridor walls, a table top between two walls stay. Each point goes to the plane
-// it is nearest to in units of that plane's tolerance (coplanar_sigmas x rms, in
-// [min_residual_m, max_residual_m]). Largest first, so that a plane's fate is decided
-// before it explains smaller ones.
+// A plane of points that larger confirmed planes explain adds no surface of its own. It
+// goes when
+// - fewer than min_points of its points are on no larger confirmed plane and at least
+//   kStrip are on each of two of them within 45 deg of it: a mixture of two surfaces
+//   nearly parallel to it (a wall and the shelf before it) that one image's vote put
+//   together and a tilted plane fits (two parallel strips always lie on one plane); what
+//   is left would not be taken as a plane;
+// - or most of its points are on one larger confirmed plane within 45 deg of it: that
+//   plane's points seen leaning (at 320x240 a strip of a shelf front's landmarks, their
+//   depth errors shared, fitted 17 deg off with a few of the wall below: a confirmed
+//   plane matching no surface).
+// A true face keeps most of its points off the others (only its edges are on them: a
+// door ajar by 20 deg has a band of about 0.1 m of its width within a wall's 0.03 m),
+// and the surfaces its edges touch are across it: a floor along one wall's foot or into
+// a corner, a ceiling along two corridor walls, a table top between two walls stay. Each
+// point goes to the plane it is nearest to in units of that plane's tolerance
+// (coplanar_sigmas x rms, in [min_residual_m, max_residual_m]). Largest first, so that a
+// plane's fate is decided before it explains smaller ones.
 void PlaneMap::dropExplained() {
   constexpr int kStrip = 3;                // points: the fewest that show a strip's line
   constexpr double kNearParallelDeg = 45;  // nearer parallel than at right angles
@@ -508,11 +514,10 @@ void PlaneMap::dropExplained() {
                             std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
                             parallel});
     }
-    if (near_parallel < 2) continue;
+    if (near_parallel == 0) continue;
     on.assign(explainers.size(), 0);
     int own = 0;
     for (const auto& [id, entry] : plane.points) {
-      if (own >= params_.min_points) break;  // kept whatever the rest is
       int nearest = -1;
       double nearest_ratio = 1;
       for (size_t e = 0; e < explainers.size(); ++e) {
@@ -530,9 +535,13 @@ void PlaneMap::dropExplained() {
         ++on[nearest];
     }
     int strips = 0;
-    for (size_t e = 0; e < explainers.size(); ++e)
-      strips += explainers[e].near_parallel && on[e] >= kStrip;
-    dropped[order[k]] = own < params_.min_points && strips >= 2;
+    bool leaning_copy = false;
+    for (size_t e = 0; e < explainers.size(); ++e) {
+      if (!explainers[e].near_parallel) continue;
+      strips += on[e] >= kStrip;
+      leaning_copy |= 2 * static_cast<size_t>(on[e]) > plane.points.size();
+    }
+    dropped[order[k]] = (own < params_.min_points && strips >= 2) || leaning_copy;
   }
   for (size_t i = planes_.size(); i-- > 0;)
     if (dropped[i]) planes_.erase(planes_.begin() + static_cast<long>(i));

@@ -139,9 +139,10 @@ class PlaneMap {
   // `merged`: the id of a plane merged into this one (not a reference for it).
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged = -1) const;
   void mergeDuplicates(const cv::Vec3d& viewpoint);
-  // Removes the planes whose points larger confirmed planes explain (a mixture of two of
-  // their surfaces): fewer than min_points on none of them, and a strip of them on each
-  // of two within 45 deg of the plane.
+  // Removes the planes whose points larger confirmed planes explain: a mixture of two of
+  // their surfaces (fewer than min_points on none of them, and a strip of them on each of
+  // two within 45 deg of the plane), or one's points seen leaning (most of them on one
+  // within 45 deg).
   void dropExplained();
   void fadeAndBound(double stamp);
 
