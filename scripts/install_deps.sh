@@ -19,7 +19,11 @@ PACKAGES=(
   libyaml-cpp-dev libopencv-dev libopencv-contrib-dev libeigen3-dev libboost-program-options-dev
   libimage-geometry-dev
   libstd-srvs-dev python3-std-srvs python3-rosservice
-  ros-image-proc
+  # image_proc/resize (launch files' resize_scale): Debian puts its nodelet plugin
+  # description and the library link pluginlib loads in the -dev package; with
+  # ros-image-proc alone the resize cannot load and every nodelet manager logs a
+  # pluginlib ERROR about image_proc's nodelet_plugins.xml.
+  ros-image-proc libimage-proc-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
 )
 
