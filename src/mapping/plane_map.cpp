@@ -469,17 +469,20 @@ void PlaneMap::mergeDuplicates(const cv::Vec3d& viewpoint) {
 //   nearly parallel to it (a wall and the shelf before it) that one image's vote put
 //   together and a tilted plane fits (two parallel strips always lie on one plane); what
 //   is left would not be taken as a plane;
-// - or most of its points are on one larger confirmed plane within 45 deg of it: that
-//   plane's points seen leaning (at 320x240 a strip of a shelf front's landmarks, their
-//   depth errors shared, fitted 17 deg off with a few of the wall below: a confirmed
-//   plane matching no surface).
-// A true face keeps most of its points off the others (only its edges are on them: a
-// door ajar by 20 deg has a band of about 0.1 m of its width within a wall's 0.03 m),
-// and the surfaces its edges touch are across it: a floor along one wall's foot or into
-// a corner, a ceiling along two corridor walls, a table top between two walls stay. Each
+// - or most of its points are one larger confirmed plane's own (the same tracks, there
+//   within its tolerance) and that plane is within 45 deg of it: its points seen leaning
+//   (at 320x240 a strip of a shelf front's landmarks, their depth errors shared, fitted
+//   17 deg off with a few of the wall below, beside the shelf's own plane: a confirmed
+//   plane matching no surface). The same tracks, not only the same place: landmarks
+//   bunch at joins (a door's hinge and frame, the foot of a ramp, an obtuse corner), and
+//   a true face there has most of its points within a neighbour's tolerance but its own.
+// A true face keeps most of its points off the others (only its edges are on them), and
+// the surfaces its edges touch are across it: a floor along one wall's foot or into a
+// corner, a ceiling along two corridor walls, a table top between two walls stay. Each
 // point goes to the plane it is nearest to in units of that plane's tolerance
 // (coplanar_sigmas x rms, in [min_residual_m, max_residual_m]). Largest first, so that a
-// plane's fate is decided before it explains smaller ones.
+// plane's fate is decided before it explains smaller ones. A plane that goes takes its
+// points with it (the larger plane has the shared ones).
 void PlaneMap::dropExplained() {
   constexpr int kStrip = 3;                // points: the fewest that show a strip's line
   constexpr double kNearParallelDeg = 45;  // nearer parallel than at right angles
@@ -487,6 +490,7 @@ void PlaneMap::dropExplained() {
     cv::Vec3d normal;
     double distance, tolerance;
     bool near_parallel;  // to the plane tested
+    const MapPlane* plane;
   };
   std::vector<size_t> order(planes_.size());
   std::iota(order.begin(), order.end(), 0);
@@ -495,7 +499,8 @@ void PlaneMap::dropExplained() {
   });
   std::vector<bool> dropped(planes_.size(), false);
   std::vector<Explainer> explainers;
-  std::vector<int> on;  // per explainer: the tested plane's points on it
+  std::vector<int> on;      // per explainer: the tested plane's points on it
+  std::vector<int> shared;  // of those, its own tracks too
   for (size_t k = 0; k < order.size(); ++k) {
     const MapPlane& plane = planes_[order[k]];
     explainers.clear();
@@ -512,10 +517,11 @@ void PlaneMap::dropExplained() {
                                           params_.min_residual_m, params_.max_residual_m);
       explainers.push_back({other.own_normal, other.own_distance,
                             std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
-                            parallel});
+                            parallel, &other});
     }
     if (near_parallel == 0) continue;
     on.assign(explainers.size(), 0);
+    shared.assign(explainers.size(), 0);
     int own = 0;
     for (const auto& [id, entry] : plane.points) {
       int nearest = -1;
@@ -529,17 +535,19 @@ void PlaneMap::dropExplained() {
           nearest_ratio = ratio;
         }
       }
-      if (nearest < 0)
+      if (nearest < 0) {
         ++own;
-      else
+      } else {
         ++on[nearest];
+        shared[nearest] += explainers[nearest].plane->points.count(id) > 0;
+      }
     }
     int strips = 0;
     bool leaning_copy = false;
     for (size_t e = 0; e < explainers.size(); ++e) {
       if (!explainers[e].near_parallel) continue;
       strips += on[e] >= kStrip;
-      leaning_copy |= 2 * static_cast<size_t>(on[e]) > plane.points.size();
+      leaning_copy |= 2 * static_cast<size_t>(shared[e]) > plane.points.size();
     }
     dropped[order[k]] = (own < params_.min_points && strips >= 2) || leaning_copy;
   }

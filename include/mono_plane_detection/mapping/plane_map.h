@@ -141,8 +141,8 @@ class PlaneMap {
   void mergeDuplicates(const cv::Vec3d& viewpoint);
   // Removes the planes whose points larger confirmed planes explain: a mixture of two of
   // their surfaces (fewer than min_points on none of them, and a strip of them on each of
-  // two within 45 deg of the plane), or one's points seen leaning (most of them on one
-  // within 45 deg).
+  // two within 45 deg of the plane), or one's points seen leaning (most of them that
+  // one's own tracks, on it, and it within 45 deg).
   void dropExplained();
   void fadeAndBound(double stamp);
 
