@@ -61,11 +61,14 @@ trap 'kill -INT $launch 2>/dev/null; wait $launch 2>/dev/null || true' EXIT
 # The manager's process id, for its resident memory: roslaunch names it when it starts.
 pid=0
 for _ in $(seq 60); do
-  pid=$(sed -n 's/.*process\[plane_detection_manager-[0-9]*\]: started with pid \[\([0-9]*\)\].*/\1/p' \
+  # (in the camera's namespace: process[camera/plane_detection_manager-2])
+  pid=$(sed -n 's/.*process\[\([^]]*\/\)\{0,1\}plane_detection_manager-[0-9]*\]: started with pid \[\([0-9]*\)\].*/\2/p' \
     "$results/latency_pipeline.log" | head -1)
   [ -n "$pid" ] && break
   pid=0
   sleep 0.5
 done
+[ "$pid" != 0 ] || echo "benchmark: the manager's process id not found in" \
+  "$results/latency_pipeline.log: no resident memory figures" >&2
 rosrun mono_plane_detection benchmark_latency --bag "$bag" --rate 30 --pid "$pid" \
   --plot "$results/benchmark_latency.png"
