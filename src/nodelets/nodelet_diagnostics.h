@@ -60,10 +60,12 @@ class WallRateStatus : public diagnostic_updater::DiagnosticTask {
     trim(now);
     // Nothing yet since the start or the subscription, and that only for a moment.
     const bool waiting = started_.isZero() && (now - waiting_since_).toSec() <= window_s_;
-    // Until a whole window has passed since the first message, rate over what there is.
+    // Until a whole window has passed since the first message, rate over what there is,
+    // but over a second at least: one message 4 ms after the first is no 265 Hz (it said
+    // "frequency too high" at start; hostile try).
     const double span = started_.isZero()
                             ? window_s_
-                            : std::min(window_s_, std::max((now - started_).toSec(), 1e-3));
+                            : std::min(window_s_, std::max((now - started_).toSec(), 1.0));
     const double hz = static_cast<double>(ticks_.size()) / span;
     if (idle_)
       status.summary(diagnostic_msgs::DiagnosticStatus::OK,

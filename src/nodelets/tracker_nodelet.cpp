@@ -232,7 +232,10 @@ class TrackerNodelet : public nodelet::Nodelet {
       problems.add(DiagnosticStatus::ERROR, "subscription", subscribe_error_);
     const std::string info_mismatch = front_.infoMismatch();
     if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
-    std::string ok_text = "tracking";
+    // Lazy and nobody listens: nothing is subscribed, nothing tracked (it said "tracking").
+    std::string ok_text = subscribed_at_.isZero() && front_.params().lazy
+                              ? "idle: nobody listens, nothing tracked (lazy)"
+                              : "tracking";
     if (!subscribed_at_.isZero()) {
       // Subscribed (not idle) and no image for a while, yet or lately: nothing is tracked.
       // (Not at once: a driver takes a moment to send its first image after a subscription.)

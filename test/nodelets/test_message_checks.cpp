@@ -413,6 +413,12 @@ TEST(WallRateStatus, WaitsAWindowForTheFirstInputAndCountsAfreshOnEachSubscripti
   EXPECT_EQ(report(38), is(DiagnosticStatus::WARN, "no input yet"));
   for (t = 38; t < 44; t += 1.0 / 5) rate.tick(at(t));  // 5 Hz for a whole window
   EXPECT_EQ(report(44), is(DiagnosticStatus::WARN, "frequency too low"));
+  // Two messages 4 ms apart after a resubscription are no 500 Hz.
+  rate.setIdle(true, at(45));
+  rate.setIdle(false, at(46));
+  rate.tick(at(46.5));
+  rate.tick(at(46.504));
+  EXPECT_EQ(report(46.508).first, static_cast<int>(DiagnosticStatus::OK)) << report(46.508).second;
 }
 
 TEST(PlaneMessages, DeleteAllMarkerClearsEveryPlaneInTheGivenFrame) {

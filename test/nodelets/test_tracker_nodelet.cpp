@@ -653,6 +653,7 @@ TEST_F(TrackerNodeletTest, ALazySubscriptionThatFailsIsReported) {
   DiagnosticsProbe rate(nh_, "tracker_lazy_no_transport: input rate");
   ASSERT_TRUE(diagnostics.waitFresh());
   EXPECT_EQ(diagnostics.level(), diagnostic_msgs::DiagnosticStatus::OK) << diagnostics.message();
+  EXPECT_EQ(diagnostics.message(), "idle: nobody listens, nothing tracked (lazy)");
   // Nobody listens: no input is expected (it was WARN "no input yet" on an idle robot).
   ASSERT_TRUE(rate.waitFresh());
   EXPECT_EQ(rate.level(), diagnostic_msgs::DiagnosticStatus::OK) << rate.message();
