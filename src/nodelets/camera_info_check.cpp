@@ -148,6 +148,13 @@ std::string infoSizeMismatch(const cv::Size& info_size, const cv::Size& image_si
                        : "planes stay in image space")
       << "); publish the camera's binning_x/y or ROI in camera_info, or a calibration made at "
       << image_size.width << "x" << image_size.height;
+  // image_proc/resize (resize_scale) rounds the image's size but truncates camera_info's:
+  // one pixel short in a side is that, from a size the scale does not divide.
+  const int dw = image_size.width - info_size.width, dh = image_size.height - info_size.height;
+  if (dw >= 0 && dh >= 0 && dw <= 1 && dh <= 1)
+    why << " (one pixel short: image_proc/resize, as resize_scale uses it, on a size that "
+           "1/resize_scale does not divide: 0.5 needs even sides, 0.25 sides divisible by 4; "
+           "else no resize_scale)";
   return why.str();
 }
 

@@ -258,6 +258,10 @@ TEST(CameraInfoCheck, BinningAndRegionOfInterestScaleAndShiftTheCamera) {
                 .find("the last camera_info of their size still is"),
             std::string::npos);
   EXPECT_EQ(infoSizeMismatch({640, 480}, {640, 480}), "");
+  // A 1279x959 camera through resize_scale 0.5: a 640x480 image, a 639x479 camera_info.
+  EXPECT_NE(infoSizeMismatch({639, 479}, {640, 480}).find("image_proc/resize"),
+            std::string::npos);
+  EXPECT_EQ(text.find("image_proc/resize"), std::string::npos);
 }
 
 // A stray camera_info of another size (a second driver on the topic) does not take the
