@@ -54,6 +54,9 @@ TEST(InstallSpace, RunsFromTheInstallSpaceAlone) {
          "from mono_plane_detection.cfg import PlanesConfig\nprint(\"python ok\")'\n"
       << "roslaunch --dump-params mono_plane_detection plane_detection.launch > /dev/null"
          " && echo 'launch ok'\n"
+      // A refused resize_scale stops the launch and names the value.
+      << "roslaunch --nodes mono_plane_detection plane_detection.launch resize_scale:=0.3 2>&1"
+         " | grep -o 'must be 0.5 or 0.25, not 0.3'\n"
       << "echo \"libraries not found: $(ldd $P/lib/libmono_plane_detection_nodelets.so"
          " $P/lib/mono_plane_detection/detect_target | grep -c 'not found')\"\n"
       << "rosrun mono_plane_detection detect_target --profile nosuch x.png\n"
@@ -67,6 +70,7 @@ TEST(InstallSpace, RunsFromTheInstallSpaceAlone) {
   EXPECT_NE(text.find(share + "/nodelets.xml"), std::string::npos) << text;
   EXPECT_NE(text.find("python ok"), std::string::npos) << text;
   EXPECT_NE(text.find("launch ok"), std::string::npos) << text;
+  EXPECT_NE(text.find("must be 0.5 or 0.25, not 0.3"), std::string::npos) << text;
   EXPECT_NE(text.find("libraries not found: 0\n"), std::string::npos) << text;
   // The tool names the profile it looked for: in the install space's config/.
   EXPECT_NE(text.find("no profile " + share + "/config/tracker_nosuch.yaml"), std::string::npos)
