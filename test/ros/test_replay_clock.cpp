@@ -6,7 +6,6 @@
 #include <rosgraph_msgs/Clock.h>
 
 #include <string>
-#include <vector>
 
 #include "../support/test_timeouts.h"
 
