@@ -78,6 +78,10 @@ class WindowCounts {
     forget(now);
     entries_.push_back({now, a, b});
   }
+  void clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entries_.clear();
+  }
   // The sums of a and of b over the window.
   std::pair<long, long> sums() const {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -124,6 +128,11 @@ class StreamHealth {
   static constexpr long kBackwardsFlood = 3;
   void received(long missing_found) { stream_.add(1, missing_found); }
   void wentBackwards() { backwards_.add(1); }
+  // The stream is gone (a lazy nodelet's last listener left): its lately is no problem now.
+  void forget() {
+    stream_.clear();
+    backwards_.clear();
+  }
   // (key, text) of each problem now; what: "images" / "tracks"; why_missing: the likely
   // causes; restarting: what starts over each time the stamps go back; topic: "image".
   std::vector<std::pair<std::string, std::string>> problems(const std::string& what,

@@ -145,6 +145,7 @@ class TrackerNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> state_lock(state_mutex_);
       front_.reset();
       subscribed_at_ = ros::WallTime();
+      stream_health_.forget();  // (its WARN stayed 5 s while idle: hostile try)
     }
   }
 

@@ -474,6 +474,8 @@ TEST(StreamHealth, MissingShareAndAFloodOfTimeJumps) {
             "time went backwards 3 times in the last 10 s, tracking starting over each time: "
             "two publishers on one image topic, or two /clock sources?");
   EXPECT_TRUE(StreamHealth().problems("tracks", "", "", "tracks").empty());
+  health.forget();  // the stream gone (the last listener left)
+  EXPECT_TRUE(health.problems("images", "why", "tracking starting over", "image").empty());
 }
 
 TEST(RecentEvents, LogsOncePerKindAndTellsWhatHappenedLately) {
