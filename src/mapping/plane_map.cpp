@@ -487,10 +487,9 @@ void PlaneMap::dropExplained() {
   constexpr int kStrip = 3;                // points: the fewest that show a strip's line
   constexpr double kNearParallelDeg = 45;  // nearer parallel than at right angles
   struct Explainer {
-    cv::Vec3d normal;
-    double distance, tolerance;
+    const MapPlane* plane;  // its points' own plane (own_normal, own_distance) explains
+    double tolerance;
     bool near_parallel;  // to the plane tested
-    const MapPlane* plane;
   };
   std::vector<size_t> order(planes_.size());
   std::iota(order.begin(), order.end(), 0);
@@ -515,21 +514,23 @@ void PlaneMap::dropExplained() {
       near_parallel += parallel;
       const double tolerance = std::clamp(params_.coplanar_sigmas * other.rms_m,
                                           params_.min_residual_m, params_.max_residual_m);
-      explainers.push_back({other.own_normal, other.own_distance,
-                            std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
-                            parallel, &other});
+      explainers.push_back({&other, std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
+                            parallel});
     }
     if (near_parallel == 0) continue;
     on.assign(explainers.size(), 0);
     shared.assign(explainers.size(), 0);
     int own = 0;
+    const int size = static_cast<int>(plane.points.size());
     for (const auto& [id, entry] : plane.points) {
+      // Kept whatever the rest is: min_points of its own, and no majority left for another.
+      if (own >= params_.min_points && 2 * own >= size) break;
       int nearest = -1;
       double nearest_ratio = 1;
       for (size_t e = 0; e < explainers.size(); ++e) {
-        const double ratio =
-            std::abs(explainers[e].normal.dot(entry.first) - explainers[e].distance) /
-            explainers[e].tolerance;
+        const MapPlane& by = *explainers[e].plane;
+        const double ratio = std::abs(by.own_normal.dot(entry.first) - by.own_distance) /
+                             explainers[e].tolerance;
         if (ratio <= nearest_ratio) {
           nearest = static_cast<int>(e);
           nearest_ratio = ratio;
@@ -547,7 +548,7 @@ void PlaneMap::dropExplained() {
     for (size_t e = 0; e < explainers.size(); ++e) {
       if (!explainers[e].near_parallel) continue;
       strips += on[e] >= kStrip;
-      leaning_copy |= 2 * static_cast<size_t>(shared[e]) > plane.points.size();
+      leaning_copy |= 2 * shared[e] > size;
     }
     dropped[order[k]] = (own < params_.min_points && strips >= 2) || leaning_copy;
   }

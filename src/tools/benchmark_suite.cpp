@@ -83,21 +83,22 @@ std::vector<double> timeTracker(const std::vector<cv::Mat>& images, int features
   return t;
 }
 
-// The floor cost of tracking: goodFeaturesToTrack every 10 images (or when fewer than a
-// third of the corners its last search found are left, the paper's 2/3 loss as the tracker
-// counts it; a third of max_features made it search every image where an image holds
-// fewer corners), LK in between, same pyramid and window, no ids, no checks, no matching.
+// The floor cost of tracking: goodFeaturesToTrack when the tracker's own rule says so
+// (shouldSearch: every redetect_every images, or 2/3 of the last search's corners lost),
+// LK in between, same pyramid and window, no ids, no checks, no matching.
 std::vector<double> timeBaselineTracker(const std::vector<cv::Mat>& images, int features) {
   const TrackerParams p;
   std::vector<double> t;
   std::vector<cv::Point2f> points;
-  size_t found_at_search = 0;
+  int found_at_search = 0, since_search = 0;
   cv::Mat previous;
   for (size_t k = 0; k < images.size(); ++k) {
     const auto start = Clock::now();
-    if (k % 10 == 0 || 3 * points.size() < found_at_search) {
+    if (k == 0 ||
+        shouldSearch(found_at_search, static_cast<int>(points.size()), ++since_search, p)) {
       cv::goodFeaturesToTrack(images[k], points, features, p.quality_level, p.min_distance_px);
-      found_at_search = points.size();
+      found_at_search = static_cast<int>(points.size());
+      since_search = 0;
     } else {
       std::vector<cv::Point2f> next;
       std::vector<uchar> status;

@@ -155,14 +155,14 @@ RowResult runRow(const Sequence& seq, int features, const TrackerParams& base) {
   std::set<std::uint64_t> first;
   double followed = 0, tracked = 0, floor_followed = 0;
   long reidentified = 0, added = 0;
-  // The floor: goodFeaturesToTrack every 10 images (or when fewer than a third of the
-  // corners its last search found are left: the paper's 2/3 loss, as the tracker counts
-  // it), calcOpticalFlowPyrLK from the previous image on the others; the tracker's
-  // pyramid, window and corner settings; no ids, no checks, no matching. (A third of
-  // max_features instead made the floor search every image wherever an image holds
-  // fewer corners than that: 320x240 real frames with 500 features, none tracked.)
+  // The floor: goodFeaturesToTrack when the tracker's own rule (shouldSearch: every
+  // redetect_every images, or 2/3 of the last search's corners lost) says so,
+  // calcOpticalFlowPyrLK from the previous image on the others; the tracker's pyramid,
+  // window and corner settings; no ids, no checks, no matching. (Its own rule, a third of
+  // max_features left, made it search every image wherever an image holds fewer corners
+  // than that: 320x240 real frames with 500 features, none tracked.)
   std::vector<cv::Point2f> points, next;
-  size_t found_at_search = 0;
+  int found_at_search = 0, since_search = 0;
   std::vector<uchar> status;
   std::vector<float> error;
   // Both on each image in turn, so that a busy machine slows both alike.
@@ -173,10 +173,12 @@ RowResult runRow(const Sequence& seq, int features, const TrackerParams& base) {
       return tracker.lastStats().searched || tracker.lastStats().search_rest;
     });
     floor.measure(k, [&] {
-      if (k % 10 == 0 || 3 * points.size() < found_at_search) {
+      if (k == 0 || shouldSearch(found_at_search, static_cast<int>(points.size()),
+                                 ++since_search, params)) {
         cv::goodFeaturesToTrack(seq.images[k], points, features, params.quality_level,
                                 params.min_distance_px, cv::noArray(), params.block_size);
-        found_at_search = points.size();
+        found_at_search = static_cast<int>(points.size());
+        since_search = 0;
         return true;
       }
       floor_followed += static_cast<double>(points.size());
@@ -353,8 +355,8 @@ int main(int argc, char** argv) {
       "benchmark_tracker_floor: one thread, %d images per row, median of %d runs (swing\n"
       "left-right and bob,\n"
       "up to ~8 px per image, sensor noise 3 grey levels), tracker defaults but max_features.\n"
-      "floor = goodFeaturesToTrack every 10 images (or < 1/3 of its last search's left) +\n"
-      "calcOpticalFlowPyrLK,\n"
+      "floor = goodFeaturesToTrack when the tracker's rule says (every 10 images, 2/3 of\n"
+      "the last search's lost) + calcOpticalFlowPyrLK,\n"
       "run on each image right after ours. ms = CPU ms of the thread per image (mean / p95 /\n"
       "max; wall = wall-clock mean, the machine is shared); alloc = heap allocations per\n"
       "image from image %d on (whole process, OpenCV included), images without / with\n"
