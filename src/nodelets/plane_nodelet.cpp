@@ -2,7 +2,6 @@
 // map planes, image planes, the camera pose, rviz markers, the map's points, tf and a
 // debug image out. Frames, tf modes and services: docs/ros_interface.md.
 #include <cv_bridge/cv_bridge.h>
-#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <image_transport/image_transport.h>
@@ -39,6 +38,7 @@
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
 #include "recent_events.h"
+#include "reconfigure_bridge.h"
 #include "ros_params.h"
 #include "stretched_wait.h"
 #include "tf_tree_view.h"
@@ -112,7 +112,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       p->shutdown();
     reset_srv_.shutdown();
     save_srv_.shutdown();
-    reconfigure_.reset();
+    reconfigure_.stop();
     tf_listener_.reset();
     tf_view_.reset();
     tf_buffer_.reset();
@@ -202,89 +202,26 @@ class PlaneNodelet : public nodelet::Nodelet {
         "camera_info", 2, guard_.message("camera_info", this, &PlaneNodelet::onCameraInfo));
   }
 
-  // dynamic_reconfigure for the parameters read on every image (cfg/Planes.cfg, made
-  // from the table). Its server starts from the parameter server: the values just read
-  // (YAML, nested names) are put there under the flat names first, or it would start
-  // from the .cfg defaults and override them.
+  // dynamic_reconfigure for the parameters read on every image (cfg/Planes.cfg).
   void startReconfigure(ros::NodeHandle& pnh) {
-    for (const std::string& name : planeRuntimeParamNames()) {
-      const auto* spec = findParam(planeNodeParamTable(), name);
-      const std::string flat = runtimeCfgName(name);
-      cfg_names_[flat] = name;
-      std::visit(
-          [&](auto* v) {
-            using T = std::remove_pointer_t<decltype(v)>;
-            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
-              pnh.setParam(flat, *v);
-            else if constexpr (!std::is_same_v<T, std::string>)
-              pnh.setParam(flat, static_cast<int>(*v));
-          },
-          spec->field(node_));
-    }
-    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<PlanesConfig>>(pnh);
-    reconfigure_->setCallback([this](PlanesConfig& config, uint32_t) {
-      guard_.run("reconfigure", [&] { onReconfigure(config); });
-    });
+    reconfigure_.start(pnh, planeNodeParamTable(), planeRuntimeParamNames(), node_,
+                       [this](PlanesConfig& config) {
+                         guard_.run("reconfigure", [&] { onReconfigure(config); });
+                       });
   }
 
   void onReconfigure(PlanesConfig& config) {
     std::lock_guard<std::mutex> lock(mutex_);
     PlaneNodeParams node = node_;
-    for (const auto& description : PlanesConfig::__getParamDescriptions__()) {
-      const auto it = cfg_names_.find(description->name);
-      if (it == cfg_names_.end()) continue;
-      const auto* spec = findParam(planeNodeParamTable(), it->second);
-      boost::any value;
-      description->getValue(config, value);
-      std::visit(
-          [&](auto* v) {
-            using T = std::remove_pointer_t<decltype(v)>;
-            if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double>)
-              *v = boost::any_cast<T>(value);
-            else if constexpr (!std::is_same_v<T, std::string>)
-              *v = static_cast<T>(boost::any_cast<int>(value));
-          },
-          spec->field(node));
-    }
+    reconfigure_.read(config, node);
     const std::vector<std::string> errors = validate(node);
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
     reconfigure_errors_ = errors;
-    if (!errors.empty()) writeBack(node, config);
+    if (!errors.empty()) reconfigure_.writeBack(node, config);
     node_ = node;
     params_ = node.pipeline;
     pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
     ++reconfigures_;
-  }
-
-  // The values in use, after validate() repaired what was refused, written back into the
-  // reconfigure's config: the server then reports and stores them (it showed a NaN the
-  // nodelet had replaced by the default).
-  void writeBack(PlaneNodeParams& node, PlanesConfig& config) const {
-    dynamic_reconfigure::Config message;
-    config.__toMessage__(message);
-    auto inUse = [&](const std::string& flat) {
-      const auto it = cfg_names_.find(flat);
-      return it == cfg_names_.end() ? nullptr : findParam(planeNodeParamTable(), it->second);
-    };
-    auto put = [&](auto& parameters) {
-      for (auto& p : parameters) {
-        const auto* spec = inUse(p.name);
-        if (!spec) continue;
-        std::visit(
-            [&](auto* v) {
-              using T = std::remove_pointer_t<decltype(v)>;
-              using Out = decltype(p.value);
-              if constexpr (std::is_same_v<Out, double>
-                                ? std::is_same_v<T, double>
-                                : std::is_integral_v<T> && !std::is_same_v<T, bool>)
-                p.value = static_cast<Out>(*v);
-            },
-            spec->field(node));
-      }
-    };
-    put(message.doubles);
-    put(message.ints);
-    config.__fromMessage__(message);
   }
 
   void connect() {
@@ -1055,8 +992,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   ros::ServiceServer reset_srv_, save_srv_;
-  std::unique_ptr<dynamic_reconfigure::Server<PlanesConfig>> reconfigure_;
-  std::map<std::string, std::string> cfg_names_;  // .cfg name -> table name
+  ReconfigureBridge<PlanesConfig, PlaneNodeParams> reconfigure_;
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
   image_transport::Publisher debug_pub_;
   image_transport::Subscriber image_sub_;

@@ -58,6 +58,12 @@ TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
   target_startup_ = TargetStartup(params_.target);
 }
 
+std::string TrackerFrontEnd::setTrackerParams(const TrackerParams& params) {
+  const std::string error = tracker_.setParams(params);
+  if (error.empty()) params_.tracker = params;
+  return error;
+}
+
 std::string TrackerFrontEnd::setCameraInfo(const sensor_msgs::CameraInfo& info) {
   std::string error = cameraInfoError(info);
   // A raw image's K and D, a rectified one's P (image_geometry's camera model).

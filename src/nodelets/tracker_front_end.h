@@ -65,6 +65,9 @@ class TrackerFrontEnd {
   // Kept for its size (checked against the images); the reason when unusable.
   std::string setCameraInfo(const sensor_msgs::CameraInfo& info);
   void reset();  // nobody listens: forget everything but the counts
+  // The tracker's parameters while it runs (dynamic_reconfigure; FeatureTracker::setParams):
+  // "" when taken, else why not and nothing changes. Validated by the caller.
+  std::string setTrackerParams(const TrackerParams& params);
   // The images are rectified (image_proc's image_rect*): camera_info's P describes them,
   // without distortion (image_geometry); else K and D. Call before setCameraInfo.
   void setRectified(bool rectified) { rectified_ = rectified; }

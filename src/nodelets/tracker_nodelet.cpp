@@ -17,7 +17,9 @@
 #include "camera_info_check.h"
 #include "mono_plane_detection/viz/draw_tracks.h"
 #include "nodelet_diagnostics.h"
+#include "mono_plane_detection/TrackerConfig.h"
 #include "recent_events.h"
+#include "reconfigure_bridge.h"
 #include "ros_params.h"
 #include "tracker_front_end.h"
 
@@ -44,6 +46,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     tracks_pub_.shutdown();
     debug_pub_.shutdown();
     reset_srv_.shutdown();
+    reconfigure_.stop();
     it_.reset();
   }
 
@@ -66,6 +69,12 @@ class TrackerNodelet : public nodelet::Nodelet {
 
     diagnostics_.start(nh, pnh, getName(), "tracking", this, &TrackerNodelet::diagnose, guard_,
                        params.expected_min_rate_hz, params.expected_max_rate_hz);
+    // The corner search, its triggers, LK's stopping rules and checks, re-identification
+    // (cfg/Tracker.cfg): taken between images, without losing the tracks.
+    reconfigure_.start(pnh, trackerNodeParamTable(), trackerRuntimeParamNames(), front_.params(),
+                       [this](TrackerConfig& config) {
+                         guard_.run("reconfigure", [&] { onReconfigure(config); });
+                       });
 
     it_ = std::make_unique<image_transport::ImageTransport>(nh);
     std::lock_guard<std::mutex> lock(connect_mutex_);
@@ -75,6 +84,20 @@ class TrackerNodelet : public nodelet::Nodelet {
     if (!front_.params().lazy) subscribe();
     diagnostics_.setIdle(front_.params().lazy);  // until a listener comes
     reset_srv_ = pnh.advertiseService("reset", &TrackerNodelet::onReset, this);
+  }
+
+  void onReconfigure(TrackerConfig& config) {
+    std::lock_guard<std::mutex> lock(state_mutex_);
+    TrackerNodeParams node = front_.params();
+    reconfigure_.read(config, node);
+    std::vector<std::string> errors = validate(node);
+    // (Only the tracker's runtime parameters are in the .cfg: FeatureTracker takes them.)
+    if (const std::string refused = front_.setTrackerParams(node.tracker); !refused.empty())
+      errors.push_back(refused);
+    for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
+    reconfigure_errors_ = errors;
+    if (!errors.empty()) reconfigure_.writeBack(front_.params(), config);
+    ++reconfigures_;
   }
 
   // ~reset: every track and the start-up target start over (ids keep increasing, so no
@@ -263,8 +286,12 @@ class TrackerNodelet : public nodelet::Nodelet {
         "the subscriber queue overflowed: tracking is slower than the stream, e.g. under "
         "CPU load; or the driver or the network dropped them",
         "tracking starting over", "image"));
-    if (!config_errors_.empty())  // (replaced by the defaults: after the present problems)
-      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(config_errors_));
+    if (!config_errors_.empty() || !reconfigure_errors_.empty()) {
+      // (replaced by the defaults: after the present problems)
+      std::vector<std::string> all = config_errors_;
+      for (const std::string& e : reconfigure_errors_) all.push_back("reconfigure: " + e);
+      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(all));
+    }
     problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");
     problems.report(status, ok_text);
     status.add("points tracked", c.tracked_now);
@@ -287,6 +314,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     // Every start over of the tracks: ~reset calls and stamps going back (a bag loop).
     status.add("resets (total)", resets_ + c.backwards);
     status.add("resets: time went backwards (total)", c.backwards);
+    status.add("reconfigurations (total)", reconfigures_);
     status.add("start-up target", !front_.params().detect_target ? "not searched"
                                   : front_.targetFound()         ? "found"
                                                                  : "waiting");
@@ -325,6 +353,8 @@ class TrackerNodelet : public nodelet::Nodelet {
   static constexpr double kNoImagesS = 5.0;  // the input rate's window: a stream stopped
                                              // or none since the subscription
   std::vector<std::string> config_errors_;   // parameters refused at start (set in init)
+  std::vector<std::string> reconfigure_errors_;  // refused by the last reconfigure
+  long reconfigures_ = 0;
   StreamHealth stream_health_;               // images missing, time going back (last 10 s)
   std::string subscribe_error_;  // why the lazy image subscription failed, "" when it did not
   long resets_ = 0;
@@ -337,6 +367,8 @@ class TrackerNodelet : public nodelet::Nodelet {
   RecentEvents logged_;                     // the front end's warnings: one throttle per kind
 
   NodeletDiagnostics diagnostics_;
+  // Last: destroyed first, so no reconfigure callback outlives what it locks and changes.
+  ReconfigureBridge<TrackerConfig, TrackerNodeParams> reconfigure_;
 };
 
 }  // namespace mono_plane_detection

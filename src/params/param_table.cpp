@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace mono_plane_detection {
@@ -516,21 +518,81 @@ std::string runtimeCfgName(const std::string& table_name) {
   return name;
 }
 
-std::string dynamicReconfigureCfg() {
+const std::vector<std::string>& trackerRuntimeParamNames() {
+  // What FeatureTracker::setParams takes between images: the corner search, its triggers,
+  // Lucas-Kanade's stopping rules and checks, re-identification. Not the pyramid's levels
+  // nor the windows, which size the pyramids and the smallest image (a change of those
+  // needs a restart), nor the target's (its detector is made once).
+  static const std::vector<std::string> names{
+      "max_features",
+      "min_distance_px",
+      "quality_level",
+      "block_size",
+      "spread_grid_columns",
+      "corner_noise_margin",
+      "max_iterations",
+      "epsilon_px",
+      "min_eigen_threshold",
+      "predict_motion",
+      "redetect_lost_fraction",
+      "redetect_every",
+      "search_spread_images",
+      "match_radius_px",
+      "forward_backward_check",
+      "forward_backward_max_px",
+      "reanchor_on_search",
+      "reanchor_max_shift_px",
+      "mask_existing",
+      "reidentify",
+      "reid_memory_frames",
+      "reid_max_hamming",
+      "reid_ratio",
+      "reid_max_radius_px",
+  };
+  return names;
+}
+
+namespace {
+
+// The shortest text that reads back as the same double (2/3 printed with 6 digits read
+// back as another value: the .cfg's default would not be the table's).
+std::string exactText(double value) {
+  for (int digits = 6;; ++digits) {
+    std::ostringstream text;
+    text << std::setprecision(digits) << value;
+    if (digits >= 17 || std::stod(text.str()) == value) return text.str();
+  }
+}
+
+// A dynamic_reconfigure .cfg for the runtime parameters `names` of one nodelet's table.
+template <typename P>
+std::string reconfigureCfg(const ParamTable<P>& table, const std::vector<std::string>& names,
+                           const std::string& nodelet, const std::string& node,
+                           const std::string& what,
+                           const std::string& file, const std::string& flag,
+                           const std::string& test, const std::string& example) {
   std::ostringstream out;
   out << "#!/usr/bin/env python3\n"
-         "# PlaneNodelet's parameters that can change while it runs (read on every image).\n"
+         "# "
+      << nodelet << "'s parameters that can change while it runs (" << what
+      << ").\n"
          "# Generated from the parameter table (src/params/param_table.cpp) by\n"
-         "# `rosrun mono_plane_detection param_table --cfg > cfg/Planes.cfg`; do not edit by\n"
-         "# hand (test_planes_cfg fails when this file is out of date). Each name is the\n"
-         "# table's with '/' -> '_' (planes/vote_threshold_px: planes_vote_threshold_px).\n"
+         "# `rosrun mono_plane_detection param_table "
+      << flag << " > cfg/" << file
+      << ".cfg`; do not edit by\n"
+         "# hand ("
+      << test
+      << " fails when this file is out of date). Each name is the\n"
+         "# table's with '/' -> '_' ("
+      << example
+      << ").\n"
          "PACKAGE = \"mono_plane_detection\"\n\n"
          "from dynamic_reconfigure.parameter_generator_catkin import ParameterGenerator, "
          "bool_t, double_t, int_t\n\n"
          "gen = ParameterGenerator()\n";
-  PlaneNodeParams defaults;
-  for (const std::string& name : planeRuntimeParamNames()) {
-    const ParamSpec<PlaneNodeParams>* spec = findParam(planeNodeParamTable(), name);
+  P defaults;
+  for (const std::string& name : names) {
+    const ParamSpec<P>* spec = findParam(table, name);
     if (!spec) throw std::logic_error("runtime parameter " + name + " is not in the table");
     const ParamField value = spec->field(defaults);
     std::string description = spec->description + (spec->unit.empty() ? "" : " (" + spec->unit + ")");
@@ -543,8 +605,8 @@ std::string dynamicReconfigureCfg() {
           if constexpr (std::is_same_v<T, bool>) {
             out << "bool_t, 0, \"" << description << "\", " << (*v ? "True" : "False");
           } else if constexpr (std::is_same_v<T, double>) {
-            out << "double_t, 0, \"" << description << "\", " << *v << ", " << spec->min << ", "
-                << spec->max;
+            out << "double_t, 0, \"" << description << "\", " << exactText(*v) << ", "
+                << exactText(spec->min) << ", " << exactText(spec->max);
           } else if constexpr (std::is_same_v<T, std::string>) {
             throw std::logic_error("string parameter " + name + " is not for dynamic_reconfigure");
           } else {
@@ -555,8 +617,23 @@ std::string dynamicReconfigureCfg() {
         value);
     out << ")\n";
   }
-  out << "\nexit(gen.generate(PACKAGE, \"plane_nodelet\", \"Planes\"))\n";
+  out << "\nexit(gen.generate(PACKAGE, \"" << node << "\", \"" << file
+      << "\"))\n";
   return out.str();
+}
+
+}  // namespace
+
+std::string dynamicReconfigureCfg() {
+  return reconfigureCfg(planeNodeParamTable(), planeRuntimeParamNames(), "PlaneNodelet",
+                        "plane_nodelet", "read on every image", "Planes", "--cfg", "test_planes_cfg",
+                        "planes/vote_threshold_px: planes_vote_threshold_px");
+}
+
+std::string trackerReconfigureCfg() {
+  return reconfigureCfg(trackerNodeParamTable(), trackerRuntimeParamNames(), "TrackerNodelet",
+                        "tracker_nodelet", "taken between images", "Tracker", "--tracker-cfg",
+                        "test_planes_cfg's TrackerCfg", "none of these has one");
 }
 
 std::string parametersMarkdown() {

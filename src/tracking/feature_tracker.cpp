@@ -92,6 +92,41 @@ void FeatureTracker::reset() {
   spread_part_ = 0;
 }
 
+std::string FeatureTracker::setParams(const TrackerParams& params) {
+  if (params.pyramid_levels != params_.pyramid_levels ||
+      params.window_size_px != params_.window_size_px ||
+      params.reanchor_window_px != params_.reanchor_window_px)
+    return "pyramid_levels, window_size_px and reanchor_window_px cannot change while the "
+           "tracker runs (they size its pyramids): restart it with the new values";
+  pending_params_ = params;
+  if (spread_part_ == 0) applyPendingParams();
+  return "";
+}
+
+void FeatureTracker::applyPendingParams() {
+  if (!pending_params_) return;
+  trim_to_max_ = trim_to_max_ || pending_params_->max_features < params_.max_features;
+  params_ = *pending_params_;
+  pending_params_.reset();
+}
+
+// After max_features was lowered: the newest points beyond it go (current_ is oldest
+// first; the start-up target's corners stay), remembered as lost so that a later search
+// can give them their ids back. (Erasing keeps the others' prev_index: it points into
+// previous_.)
+void FeatureTracker::trimToMaxFeatures() {
+  trim_to_max_ = false;
+  size_t excess = current_.size() > static_cast<size_t>(params_.max_features)
+                      ? current_.size() - static_cast<size_t>(params_.max_features)
+                      : 0;
+  for (size_t k = current_.size(); k-- > 0 && excess > 0;) {
+    if (current_[k].is_target_corner) continue;
+    rememberLost(current_[k]);
+    current_.erase(current_.begin() + static_cast<std::ptrdiff_t>(k));
+    --excess;
+  }
+}
+
 int minimumImageSide(const TrackerParams& params) {
   // cv::cornerSubPix asserts unless the image is at least 2 x window + 5 px on each side:
   // window 3 for new corners, reanchor_window_px for live ones.
@@ -130,6 +165,7 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   current_.clear();
   if (pyramid_previous_ >= 0)
     trackFromPrevious(pyramids_[pyramid_previous_], pyramid, gray.size());
+  if (trim_to_max_) trimToMaxFeatures();
   ++frames_since_search_;
 
   // Paper II-D: the search runs on this image, before the next one is loaded, so the
@@ -161,6 +197,7 @@ const std::vector<TrackedPoint>& FeatureTracker::process(const cv::Mat& gray) {
   }
   pyramid_previous_ = pyramid_now_;
   ++frame_count_;
+  if (spread_part_ == 0) applyPendingParams();  // (a spread search just ended)
   return current_;
 }
 

@@ -981,3 +981,24 @@ TEST(PlaneMessages, SurfacesFaceTheSideTheyWereSeenFrom) {
   }
   EXPECT_EQ(walls, 2);
 }
+
+// dynamic_reconfigure's way in: the tracker's new values are taken (the next image's
+// tracks follow them) or refused with the reason and nothing changed.
+TEST(TrackerFrontEnd, TrackerParamsChangeBetweenImagesOrAreRefused) {
+  TrackerFrontEnd front;
+  const cv::Mat grey = textured({320, 240});
+  const TrackerOutput first = front.process(image(grey, 100));
+  ASSERT_TRUE(first.tracks);
+  ASSERT_GT(first.tracks->id.size(), 10u);
+  TrackerParams fewer = front.params().tracker;
+  fewer.max_features = 10;
+  EXPECT_EQ(front.setTrackerParams(fewer), "");
+  EXPECT_EQ(front.params().tracker.max_features, 10);
+  const TrackerOutput next = front.process(image(grey, 100, 100000000));
+  ASSERT_TRUE(next.tracks) << next.dropped;
+  EXPECT_EQ(next.tracks->id.size(), 10u);
+  TrackerParams other_pyramid = fewer;
+  other_pyramid.pyramid_levels = 2;
+  EXPECT_NE(front.setTrackerParams(other_pyramid), "");
+  EXPECT_EQ(front.params().tracker.pyramid_levels, TrackerParams().pyramid_levels);
+}

@@ -1,5 +1,6 @@
 // Drives TrackerNodelet with images of known motion and bad input; checks `tracks`.
 #include <cv_bridge/cv_bridge.h>
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <nodelet/NodeletList.h>
 #include <nodelet/NodeletLoad.h>
@@ -11,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -751,4 +753,73 @@ TEST_F(TrackerNodeletTest, AFailedStartLeavesTheManagerRunning) {
   for (int k = 0; k < 3; ++k) tracks = send(makeImage(view({1.0 * k, 0}), "mono8", stamp_ += 0.1));
   ASSERT_TRUE(tracks);
   EXPECT_FALSE(tracks->id.empty());
+}
+
+// dynamic_reconfigure (cfg/Tracker.cfg): max_features 20 leaves the 20 oldest points on the
+// next image, tracked on with their ids; back to 40, the next search fills up to it. A NaN
+// quality_level is refused: the default is used and reported, diagnostics name it.
+TEST_F(TrackerNodeletTest, ZReconfigureChangesTheNextImages) {
+  auto set = [&](const std::string& name, double value, bool integer) {
+    dynamic_reconfigure::Reconfigure srv;
+    if (integer) {
+      dynamic_reconfigure::IntParameter p;
+      p.name = name;
+      p.value = static_cast<int>(value);
+      srv.request.config.ints.push_back(p);
+    } else {
+      dynamic_reconfigure::DoubleParameter p;
+      p.name = name;
+      p.value = value;
+      srv.request.config.doubles.push_back(p);
+    }
+    EXPECT_TRUE(ros::service::call("/tracker/set_parameters", srv));
+    return srv.response.config;
+  };
+  stamp_ += 3000;  // after every earlier test's stamps
+  TracksConstPtr before;
+  double x = 0;
+  for (int k = 0; k < 3; ++k) before = send(makeImage(view({x += 1.0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(before);
+  ASSERT_EQ(before->id.size(), 50u);  // config/tracker.yaml
+  const std::set<uint64_t> earlier(before->id.begin(), before->id.end());
+
+  set("max_features", 20, true);
+  const TracksConstPtr fewer = send(makeImage(view({x += 1.0, 0}), "mono8", stamp_ += 0.1));
+  ASSERT_TRUE(fewer);
+  EXPECT_EQ(fewer->id.size(), 20u);
+  for (size_t i = 0; i < fewer->id.size(); ++i) {
+    EXPECT_TRUE(earlier.count(fewer->id[i])) << "id " << fewer->id[i];
+    EXPECT_TRUE(fewer->flags[i] & Tracks::FLAG_TRACKED);
+  }
+
+  set("max_features", 40, true);
+  size_t most = 0;
+  for (int k = 0; k < 11; ++k) {
+    const TracksConstPtr t = send(makeImage(view({x += 1.0, 0}), "mono8", stamp_ += 0.1));
+    ASSERT_TRUE(t);
+    most = std::max(most, t->id.size());
+  }
+  EXPECT_EQ(most, 40u);
+
+  const auto answer = set("quality_level", std::numeric_limits<double>::quiet_NaN(), false);
+  bool reported = false;
+  for (const auto& d : answer.doubles)
+    if (d.name == "quality_level") {
+      reported = true;
+      EXPECT_EQ(d.value, 0.01);  // the default (docs/parameters.md)
+    }
+  EXPECT_TRUE(reported);
+  EXPECT_TRUE(send(makeImage(view({x += 1.0, 0}), "mono8", stamp_ += 0.1)));  // tracking goes on
+  DiagnosticsProbe diagnostics(nh_, "tracker: tracking");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_NE(diagnostics.value("problem: configuration").find("reconfigure: quality_level = nan"),
+            std::string::npos)
+      << diagnostics.value("problem: configuration");
+  EXPECT_GE(diagnostics.number("reconfigurations (total)"), 3);
+  set("quality_level", 0.01, false);
+  set("max_features", 50, true);
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.value("problem: configuration"), "");
 }

@@ -1,6 +1,7 @@
-// cfg/Planes.cfg (dynamic_reconfigure) and the parameter table agree: the committed file is
-// what the table generates, and the config class built from it has, for every runtime
-// parameter, the table's type, default and range (issue 14: one declaration per parameter).
+// cfg/Planes.cfg and cfg/Tracker.cfg (dynamic_reconfigure) and the parameter tables agree:
+// each committed file is what its table generates, and the config class built from each
+// has, for every runtime parameter, the table's type, default and range (issue 14: one
+// declaration per parameter).
 #include <gtest/gtest.h>
 
 #include <boost/any.hpp>
@@ -10,36 +11,44 @@
 #include <unistd.h>
 
 #include "mono_plane_detection/PlanesConfig.h"
+#include "mono_plane_detection/TrackerConfig.h"
 #include "mono_plane_detection/params/param_table.h"
 
 using namespace mono_plane_detection;
 
-TEST(PlanesCfg, CommittedFileIsWhatTheTableGenerates) {
-  std::ifstream file(std::string(SOURCE_DIR) + "/cfg/Planes.cfg");
-  ASSERT_TRUE(file) << "cfg/Planes.cfg missing";
+namespace {
+
+// The committed .cfg is what the table generates, and executable.
+void expectCommittedFileIsGenerated(const std::string& file, const std::string& generated,
+                                    const std::string& flag) {
+  const std::string path = std::string(SOURCE_DIR) + "/cfg/" + file;
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path << " missing";
   std::stringstream text;
-  text << file.rdbuf();
-  EXPECT_EQ(text.str(), dynamicReconfigureCfg())
-      << "cfg/Planes.cfg is out of date: rosrun mono_plane_detection param_table --cfg > "
-         "cfg/Planes.cfg";
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), generated) << "cfg/" << file << " is out of date: rosrun "
+                                   << "mono_plane_detection param_table " << flag << " > cfg/"
+                                   << file;
   // dynamic_reconfigure runs the file; regenerating it by redirection drops the bit.
-  EXPECT_EQ(access((std::string(SOURCE_DIR) + "/cfg/Planes.cfg").c_str(), X_OK), 0)
-      << "cfg/Planes.cfg must be executable: chmod +x cfg/Planes.cfg";
+  EXPECT_EQ(access(path.c_str(), X_OK), 0) << "cfg/" << file << " must be executable";
 }
 
-TEST(PlanesCfg, EveryRuntimeParameterHasTheTablesTypeDefaultAndRange) {
-  const PlanesConfig min = PlanesConfig::__getMin__(), max = PlanesConfig::__getMax__(),
-                     def = PlanesConfig::__getDefault__();
+// For every runtime parameter the config class has the table's type, default and range.
+template <typename Config, typename NodeParams>
+void expectTablesTypeDefaultAndRange(const ParamTable<NodeParams>& table,
+                                     const std::vector<std::string>& names) {
+  const Config min = Config::__getMin__(), max = Config::__getMax__(),
+               def = Config::__getDefault__();
   std::set<std::string> in_cfg;
-  for (const auto& d : PlanesConfig::__getParamDescriptions__()) in_cfg.insert(d->name);
-  EXPECT_EQ(in_cfg.size(), planeRuntimeParamNames().size());
-  PlaneNodeParams defaults;
-  for (const std::string& name : planeRuntimeParamNames()) {
-    const auto* spec = findParam(planeNodeParamTable(), name);
+  for (const auto& d : Config::__getParamDescriptions__()) in_cfg.insert(d->name);
+  EXPECT_EQ(in_cfg.size(), names.size());
+  NodeParams defaults;
+  for (const std::string& name : names) {
+    const auto* spec = findParam(table, name);
     ASSERT_NE(spec, nullptr) << name;
     const std::string cfg = runtimeCfgName(name);
     ASSERT_TRUE(in_cfg.count(cfg)) << cfg;
-    for (const auto& d : PlanesConfig::__getParamDescriptions__()) {
+    for (const auto& d : Config::__getParamDescriptions__()) {
       if (d->name != cfg) continue;
       boost::any lo, hi, value;
       d->getValue(min, lo);
@@ -60,4 +69,29 @@ TEST(PlanesCfg, EveryRuntimeParameterHasTheTablesTypeDefaultAndRange) {
       }
     }
   }
+}
+
+}  // namespace
+
+TEST(PlanesCfg, CommittedFileIsWhatTheTableGenerates) {
+  expectCommittedFileIsGenerated("Planes.cfg", dynamicReconfigureCfg(), "--cfg");
+}
+
+TEST(PlanesCfg, EveryRuntimeParameterHasTheTablesTypeDefaultAndRange) {
+  expectTablesTypeDefaultAndRange<PlanesConfig>(planeNodeParamTable(), planeRuntimeParamNames());
+}
+
+TEST(TrackerCfg, CommittedFileIsWhatTheTableGenerates) {
+  expectCommittedFileIsGenerated("Tracker.cfg", trackerReconfigureCfg(), "--tracker-cfg");
+}
+
+TEST(TrackerCfg, EveryRuntimeParameterHasTheTablesTypeDefaultAndRange) {
+  expectTablesTypeDefaultAndRange<TrackerConfig>(trackerNodeParamTable(),
+                                                 trackerRuntimeParamNames());
+}
+
+// The structural parameters, which FeatureTracker::setParams refuses, are not offered.
+TEST(TrackerCfg, OffersNoParameterThatSizesThePyramids) {
+  for (const char* name : {"pyramid_levels", "window_size_px", "reanchor_window_px"})
+    for (const auto& d : TrackerConfig::__getParamDescriptions__()) EXPECT_NE(d->name, name);
 }

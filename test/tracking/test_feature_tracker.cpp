@@ -738,3 +738,101 @@ TEST(FeatureTracker, PredictedMotionWithoutTheCheckTracksAsExactly) {
       << "full pyramid " << full.score.meanError();
   EXPECT_GE(predicted.score.errors().size(), full.score.errors().size() * 99 / 100);
 }
+
+// setParams (dynamic_reconfigure): a lower max_features drops the newest points on the next
+// image, the others keep their ids and tracks; a higher one is filled by the next search.
+TEST(FeatureTracker, ALowerMaxFeaturesDropsTheNewestPointsAndKeepsTheOthers) {
+  TrackerParams params;
+  params.max_features = 100;
+  FeatureTracker tracker(params);
+  const auto hs = translations(30, kCentred, {1.0, 0.5});
+  tracker.process(warpView(texture(), hs[0], kView));
+  tracker.process(warpView(texture(), hs[1], kView));
+  ASSERT_EQ(tracker.current().size(), 100u);
+  std::vector<std::uint64_t> oldest;
+  for (size_t i = 0; i < 30; ++i) oldest.push_back(tracker.current()[i].id);
+
+  params.max_features = 30;
+  EXPECT_EQ(tracker.setParams(params), "");
+  EXPECT_EQ(tracker.params().max_features, 30);
+  const auto& points = tracker.process(warpView(texture(), hs[2], kView));
+  ASSERT_EQ(points.size(), 30u);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(points[i].id, oldest[i]);
+    EXPECT_TRUE(points[i].is_tracked);
+    // prev_index still points at the same point in the previous image's state.
+    EXPECT_EQ(tracker.previous()[points[i].prev_index].id, points[i].id);
+  }
+  // Back up: the next search (every 10 images) fills to the new maximum.
+  params.max_features = 80;
+  EXPECT_EQ(tracker.setParams(params), "");
+  size_t most = 0;
+  for (size_t k = 3; k < 15; ++k)
+    most = std::max(most, tracker.process(warpView(texture(), hs[k], kView)).size());
+  EXPECT_EQ(most, 80u);
+}
+
+// The target's corners are never the ones dropped.
+TEST(FeatureTracker, ALowerMaxFeaturesKeepsTheTargetsCorners) {
+  FeatureTracker tracker;  // 50
+  const auto hs = translations(4, kCentred, {1.0, 0.5});
+  tracker.process(warpView(texture(), hs[0], kView));
+  std::vector<cv::Point2f> corners;
+  for (int i = 0; i < 4; ++i) corners.push_back(tracker.current()[i * 5].uv);
+  const auto ids = tracker.addPoints(corners, true);  // the newest: last in current()
+  TrackerParams params;
+  params.max_features = 10;
+  ASSERT_EQ(tracker.setParams(params), "");
+  const auto& points = tracker.process(warpView(texture(), hs[1], kView));
+  EXPECT_EQ(points.size(), 10u);
+  int flagged = 0;
+  for (const auto& p : points) flagged += p.is_target_corner;
+  EXPECT_EQ(flagged, 4);
+}
+
+// The parameters that size the pyramids are refused, and nothing changes.
+TEST(FeatureTracker, SetParamsRefusesWhatSizesThePyramids) {
+  FeatureTracker tracker;
+  tracker.process(warpView(texture(), similarity(0, {}, kCentred), kView));
+  for (int which = 0; which < 3; ++which) {
+    TrackerParams params;
+    params.max_features = 20;
+    if (which == 0) params.pyramid_levels = 3;
+    if (which == 1) params.window_size_px = 15;
+    if (which == 2) params.reanchor_window_px = TrackerParams().reanchor_window_px + 2;
+    EXPECT_NE(tracker.setParams(params), "") << which;
+    EXPECT_EQ(tracker.params().max_features, 50) << which;
+  }
+  EXPECT_EQ(tracker.process(warpView(texture(), similarity(0, {1, 0}, kCentred), kView)).size(),
+            50u);
+}
+
+// A spread search in progress finishes under the values it started with; the new ones
+// apply from the image after it.
+TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
+  TrackerParams params;
+  params.max_features = 150;
+  params.search_spread_images = 5;
+  FeatureTracker tracker(params);
+  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
+  size_t k = 0;
+  tracker.process(warpView(texture(), hs[k++], kView));
+  // Up to the start of a spread search.
+  for (; k < hs.size(); ++k) {
+    tracker.process(warpView(texture(), hs[k], kView));
+    if (tracker.lastStats().searched) break;
+  }
+  ASSERT_LT(k, hs.size());
+  TrackerParams changed = params;
+  changed.quality_level = 0.05;
+  ASSERT_EQ(tracker.setParams(changed), "");
+  EXPECT_EQ(tracker.params().quality_level, params.quality_level);  // not yet
+  int rest = 0;
+  for (++k; k < hs.size() && rest < 4; ++k) {
+    tracker.process(warpView(texture(), hs[k], kView));
+    ASSERT_TRUE(tracker.lastStats().search_rest) << "image " << k;
+    ++rest;
+  }
+  EXPECT_EQ(rest, 4);
+  EXPECT_EQ(tracker.params().quality_level, 0.05);  // after its last image
+}

@@ -186,9 +186,15 @@ const ParamTable<PlaneNodeParams>& planeNodeParamTable();
 const std::vector<std::string>& planeRuntimeParamNames();
 std::string runtimeCfgName(const std::string& table_name);
 
-// cfg/Planes.cfg (dynamic_reconfigure), generated from the table for those parameters
-// (param_table --cfg; test_planes_cfg checks the committed file is up to date).
+// The TrackerNodelet parameters that can change while it runs (dynamic_reconfigure): those
+// FeatureTracker::setParams takes between images (not the pyramid or the windows).
+const std::vector<std::string>& trackerRuntimeParamNames();
+
+// cfg/Planes.cfg and cfg/Tracker.cfg (dynamic_reconfigure), generated from the tables for
+// those parameters (param_table --cfg / --tracker-cfg; test_planes_cfg checks the committed
+// files are up to date).
 std::string dynamicReconfigureCfg();
+std::string trackerReconfigureCfg();
 
 // docs/parameters.md: both nodelets' tables (generated; test_param_table checks the
 // committed file is up to date).

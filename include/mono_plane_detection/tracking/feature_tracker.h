@@ -6,8 +6,9 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
-#include <string>
 #include <opencv2/core.hpp>
+#include <optional>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -150,6 +151,15 @@ class FeatureTracker {
   // Forgets every point and image; ids keep increasing so they are never reused.
   void reset();
 
+  // New parameters between images (dynamic_reconfigure); "" when taken, else why not and
+  // nothing changes. pyramid_levels, window_size_px and reanchor_window_px size the
+  // pyramids and the smallest image: a change of those is refused (it needs a new
+  // tracker). A spread search in progress finishes under the old values; the new ones
+  // apply from the image after it. A lower max_features drops the newest points beyond it
+  // on the next image (the start-up target's corners stay; the dropped ones can be
+  // re-identified later).
+  std::string setParams(const TrackerParams& params);
+
   const std::vector<TrackedPoint>& current() const { return current_; }
   const std::vector<TrackedPoint>& previous() const { return previous_; }
   const TrackerFrameStats& lastStats() const { return stats_; }
@@ -208,6 +218,8 @@ class FeatureTracker {
   void responseBand(int band);
   void adoptCorners(const cv::Mat& gray, const std::vector<cv::Point2f>& corners);
   void reanchor(const cv::Mat& gray);
+  void applyPendingParams();
+  void trimToMaxFeatures();
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
   void rememberLost(const TrackedPoint& point);
@@ -216,6 +228,8 @@ class FeatureTracker {
                                         std::vector<cv::Point2f>& out) const;
 
   TrackerParams params_;
+  std::optional<TrackerParams> pending_params_;  // setParams during a spread search
+  bool trim_to_max_ = false;                     // max_features was lowered: trim once
   std::vector<TrackedPoint> previous_;
   std::vector<TrackedPoint> current_;
   TrackerFrameStats stats_;
