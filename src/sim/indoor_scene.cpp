@@ -264,8 +264,24 @@ IndoorScene makeRoom(const RoomParams& params) {
   if (params.walls >= 4) add("back_wall", {x0, -B, 0}, Z, X, H, W);
   if (params.ceiling) add("ceiling", {x0, -B, H}, Y, X, F + B, W);
 
+  // The photographs (params.photos) on the floor, the front and the left wall, in that
+  // order, tiled photo_tile_m wide: furnished or bare.
+  int next_photo = 0;
+  auto paintPhotos = [&](ScenePlane& p) {
+    if (params.photos.empty()) return false;
+    if (p.name != "floor" && p.name != "front_wall" && p.name != "left_wall") return false;
+    p.surface = "photo";
+    const cv::Mat& photo = params.photos[next_photo++ % params.photos.size()];
+    const double tile_h = params.photo_tile_m * photo.rows / photo.cols;
+    for (double b = 0; b < p.height_m; b += tile_h)
+      for (double a = 0; a < p.width_m; a += params.photo_tile_m)
+        paintImage(p, photo, a, b, params.photo_tile_m);
+    return true;
+  };
   int table_top = -1;
-  if (furnished) {
+  if (!furnished) {
+    for (ScenePlane& p : scene.planes) paintPhotos(p);
+  } else {
     const size_t room_planes = scene.planes.size();
     // The faces of an axis-aligned box that can be seen (`faces` of "+x-x+y-y+z-z"), each
     // a plane whose normal points out of the box.
@@ -305,21 +321,13 @@ IndoorScene makeRoom(const RoomParams& params) {
     // wall; plain paint with posters on the right and back walls and the ceiling; wood,
     // books and paint on the furniture.
     std::mt19937 rng(params.seed * 7919u + 3u);
-    int next_photo = 0;
     for (size_t k = 0; k < scene.planes.size(); ++k) {
       ScenePlane& p = scene.planes[k];
       const cv::Size size = p.texture.size();
       const unsigned seed = params.seed * 131u + static_cast<unsigned>(k);
       const std::string& n = p.name;
       if (n == "floor" || n == "front_wall" || n == "left_wall") {
-        if (!params.photos.empty()) {
-          p.surface = "photo";
-          const cv::Mat& photo = params.photos[next_photo++ % params.photos.size()];
-          const double tile_h = params.photo_tile_m * photo.rows / photo.cols;
-          for (double b = 0; b < p.height_m; b += tile_h)
-            for (double a = 0; a < p.width_m; a += params.photo_tile_m)
-              paintImage(p, photo, a, b, params.photo_tile_m);
-        }
+        paintPhotos(p);
       } else if (n == "right_wall" || n == "back_wall" || n == "ceiling" ||
                  n.rfind("door", 0) == 0 || n == "sideboard_+x" || n == "sideboard_-x" ||
                  n.rfind("table_leg", 0) == 0 || (n.rfind("table", 0) == 0 && n != "table_+z")) {

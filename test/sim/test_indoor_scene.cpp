@@ -198,6 +198,20 @@ TEST(FurnishedRoom, PlainPaintNextToRichTextureAndPhotographs) {
               10.0)
         << name;
   }
+  // The bare room too (the photographs were left out there, silently: generalization sweep).
+  RoomParams bare;
+  const IndoorScene bare_generated = makeRoom(bare);
+  bare.photos = params.photos;
+  const IndoorScene bare_photographed = makeRoom(bare);
+  for (const std::string name : {"floor", "front_wall", "left_wall"}) {
+    const ScenePlane& p = *planeNamed(bare_photographed, name);
+    EXPECT_EQ(p.surface, "photo") << name;
+    EXPECT_GT(cv::norm(p.texture, planeNamed(bare_generated, name)->texture, cv::NORM_L1) /
+                  p.texture.total(),
+              10.0)
+        << name;
+  }
+  EXPECT_NE(planeNamed(bare_photographed, "right_wall")->surface, "photo");
   EXPECT_THROW(loadTexturePhotos(std::string(TEST_DATA_DIR) + "/no_such_folder"),
                std::runtime_error);
   RoomParams bad;
