@@ -651,11 +651,13 @@ std::string parametersMarkdown() {
          "Profiles (`config/*_wheeled.yaml`, `config/*_humanoid.yaml`) are overlays of these\n"
          "names. The tools read the same files through the same tables: `run_pipeline\n"
          "--profile P` (default: the trajectory's profile) and `segment_planes --profile P`\n"
-         "(default `none`: the core's defaults; `default` is `config/planes.yaml` alone).\n\n"
+         "(default `none`: the core's defaults; `default` is `config/planes.yaml` alone).\n"
+         "Those marked **live** can also change while the nodelet runs (dynamic_reconfigure:\n"
+         "`cfg/Tracker.cfg`, `cfg/Planes.cfg`, where a `/` is a `_`; docs/ros_interface.md).\n\n"
          "## TrackerNodelet (`config/tracker.yaml`)\n\n"
-      << toMarkdown(trackerNodeParamTable())
+      << toMarkdown(trackerNodeParamTable(), trackerRuntimeParamNames())
       << "\n## PlaneNodelet (`config/planes.yaml`)\n\n"
-      << toMarkdown(planeNodeParamTable());
+      << toMarkdown(planeNodeParamTable(), planeRuntimeParamNames());
   return out.str();
 }
 

@@ -224,6 +224,15 @@ TEST(ParamTable, MarkdownHasOneRowPerParameter) {
   for (char c : md) rows += c == '\n';
   EXPECT_EQ(rows, trackerParamTable().size() + 2);
   EXPECT_NE(md.find("| `window_size_px` | 7 | 3 .. 51 | px |"), std::string::npos) << md;
+  // The runtime parameters (dynamic_reconfigure) are marked live, the others not.
+  const std::string live = toMarkdown(trackerParamTable(), trackerRuntimeParamNames());
+  const auto row = [&](const std::string& name) {
+    const size_t at = live.find("| `" + name + "` |");
+    return at == std::string::npos ? std::string() : live.substr(at, live.find('\n', at) - at);
+  };
+  EXPECT_NE(row("max_features").find("(**live**)"), std::string::npos) << row("max_features");
+  EXPECT_EQ(row("window_size_px").find("(**live**)"), std::string::npos) << row("window_size_px");
+  EXPECT_EQ(md.find("**live**"), std::string::npos);  // none without the list
 }
 
 TEST(ParamTable, CommittedDocsAreUpToDate) {

@@ -5,6 +5,7 @@
 // docs/parameters.md (param_table --markdown). ROS-free.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -124,7 +125,7 @@ const ParamSpec<P>* findParam(const ParamTable<P>& table, const std::string& nam
 
 // A Markdown table: name, default, range, unit, meaning.
 template <class P>
-std::string toMarkdown(const ParamTable<P>& table) {
+std::string toMarkdown(const ParamTable<P>& table, const std::vector<std::string>& live = {}) {
   std::ostringstream out;
   out << "| parameter | default | range | unit | meaning |\n|---|---|---|---|---|\n";
   P defaults;
@@ -132,9 +133,11 @@ std::string toMarkdown(const ParamTable<P>& table) {
     const ParamField value = spec.field(defaults);
     std::ostringstream range;
     if (isNumber(value)) range << spec.min << " .. " << spec.max;
+    const bool is_live = std::find(live.begin(), live.end(), spec.name) != live.end();
     out << "| `" << spec.name << "` | " << toString(value) << " | " << range.str() << " | "
         << spec.unit << " | " << spec.description
-        << (spec.old_name.empty() ? "" : " (was `" + spec.old_name + "`)") << " |\n";
+        << (spec.old_name.empty() ? "" : " (was `" + spec.old_name + "`)")
+        << (is_live ? " (**live**)" : "") << " |\n";
   }
   return out.str();
 }
