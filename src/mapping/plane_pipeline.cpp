@@ -125,7 +125,12 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
   }
   if (!frame.ids.empty()) {
     const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
-    if (!history_.empty() && newest < newest_id_) {
+    // A re-identified point has its old id back: the tracker remembers what it lost, so
+    // it did not start over (hostile try: one point left, lost, and found again under
+    // its old id, with max_features 1 set live, started the map over).
+    const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(),
+                                     true) != frame.reidentified.end();
+    if (!history_.empty() && newest < newest_id_ && !remembers) {
       // (Checked whenever the newest track is gone, not only at restarts: a set, not a
       // search of the last image per id.)
       const std::vector<std::uint64_t>& last_ids = history_.back().frame.ids;

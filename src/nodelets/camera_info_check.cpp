@@ -203,6 +203,7 @@ void undistortFisheye(TrackFrame& frame, const CameraIntrinsics& camera) {
   kept.ids.clear();
   kept.pixels.clear();
   kept.target_corner.clear();
+  kept.reidentified.clear();
   for (size_t i = 0; i < pinhole.size(); ++i) {
     const cv::Point2d& p = pinhole[i];
     if (!(p.x >= 0 && p.y >= 0 && p.x <= frame.size.width - 1 && p.y <= frame.size.height - 1))
@@ -210,6 +211,7 @@ void undistortFisheye(TrackFrame& frame, const CameraIntrinsics& camera) {
     kept.ids.push_back(frame.ids[i]);
     kept.pixels.push_back(p);
     kept.target_corner.push_back(frame.target_corner[i]);
+    if (!frame.reidentified.empty()) kept.reidentified.push_back(frame.reidentified[i]);
   }
   frame = std::move(kept);
 }

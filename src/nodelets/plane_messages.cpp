@@ -29,9 +29,11 @@ TrackFrame toTrackFrame(const Tracks& msg, std::string& error) {
   frame.ids.assign(msg.id.begin(), msg.id.end());
   frame.pixels.reserve(n);
   frame.target_corner.reserve(n);
+  frame.reidentified.reserve(n);
   for (size_t i = 0; i < n; ++i) {
     frame.pixels.emplace_back(msg.u[i], msg.v[i]);
     frame.target_corner.push_back((msg.flags[i] & Tracks::FLAG_TARGET_CORNER) != 0);
+    frame.reidentified.push_back((msg.flags[i] & Tracks::FLAG_REIDENTIFIED) != 0);
   }
   error = validateTrackFrame(frame);
   return frame;

@@ -205,12 +205,12 @@ class PlaneNodelet : public nodelet::Nodelet {
   // dynamic_reconfigure for the parameters read on every image (cfg/Planes.cfg).
   void startReconfigure(ros::NodeHandle& pnh) {
     reconfigure_.start(pnh, planeNodeParamTable(), planeRuntimeParamNames(), node_,
-                       [this](PlanesConfig& config) {
-                         guard_.run("reconfigure", [&] { onReconfigure(config); });
+                       [this](PlanesConfig& config, bool first) {
+                         guard_.run("reconfigure", [&] { onReconfigure(config, first); });
                        });
   }
 
-  void onReconfigure(PlanesConfig& config) {
+  void onReconfigure(PlanesConfig& config, bool first) {
     std::lock_guard<std::mutex> lock(mutex_);
     PlaneNodeParams node = node_;
     reconfigure_.read(config, node);
@@ -221,7 +221,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     node_ = node;
     params_ = node.pipeline;
     pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
-    ++reconfigures_;
+    if (!first) ++reconfigures_;
   }
 
   void connect() {

@@ -25,10 +25,11 @@ class ReconfigureBridge {
   // Puts `current`'s runtime values on the parameter server under the flat names, then
   // starts the server on `pnh`: it starts from them (the values the nodelet read, YAML and
   // nested names included), not from the .cfg defaults, which would override them.
-  // on_change runs for every change (and once at start, as dynamic_reconfigure does).
+  // on_change runs for every change, and once as the server starts (first true then; the
+  // values are those the nodelet read).
   void start(ros::NodeHandle& pnh, const ParamTable<NodeParams>& table,
              const std::vector<std::string>& names, const NodeParams& current,
-             std::function<void(Config&)> on_change) {
+             std::function<void(Config&, bool first)> on_change) {
     table_ = &table;
     NodeParams values = current;  // (the table's accessors take a non-const object)
     for (const std::string& name : names) {
@@ -47,7 +48,11 @@ class ReconfigureBridge {
           spec->field(values));
     }
     server_ = std::make_unique<dynamic_reconfigure::Server<Config>>(pnh);
-    server_->setCallback([on_change](Config& config, uint32_t) { on_change(config); });
+    auto first = std::make_shared<bool>(true);
+    server_->setCallback([on_change, first](Config& config, uint32_t) {
+      on_change(config, *first);
+      *first = false;
+    });
   }
 
   void stop() { server_.reset(); }

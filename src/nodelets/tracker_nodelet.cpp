@@ -72,8 +72,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     // The corner search, its triggers, LK's stopping rules and checks, re-identification
     // (cfg/Tracker.cfg): taken between images, without losing the tracks.
     reconfigure_.start(pnh, trackerNodeParamTable(), trackerRuntimeParamNames(), front_.params(),
-                       [this](TrackerConfig& config) {
-                         guard_.run("reconfigure", [&] { onReconfigure(config); });
+                       [this](TrackerConfig& config, bool first) {
+                         guard_.run("reconfigure", [&] { onReconfigure(config, first); });
                        });
 
     it_ = std::make_unique<image_transport::ImageTransport>(nh);
@@ -86,7 +86,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     reset_srv_ = pnh.advertiseService("reset", &TrackerNodelet::onReset, this);
   }
 
-  void onReconfigure(TrackerConfig& config) {
+  void onReconfigure(TrackerConfig& config, bool first) {
     std::lock_guard<std::mutex> lock(state_mutex_);
     TrackerNodeParams node = front_.params();
     reconfigure_.read(config, node);
@@ -97,7 +97,7 @@ class TrackerNodelet : public nodelet::Nodelet {
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
     reconfigure_errors_ = errors;
     if (!errors.empty()) reconfigure_.writeBack(front_.params(), config);
-    ++reconfigures_;
+    if (!first) ++reconfigures_;
   }
 
   // ~reset: every track and the start-up target start over (ids keep increasing, so no

@@ -90,6 +90,8 @@ void FeatureTracker::reset() {
   pyramid_previous_ = -1;
   spread_image_ = -1;
   spread_part_ = 0;
+  applyPendingParams();  // (no spread search left to wait for, no point to trim)
+  trim_to_max_ = false;
 }
 
 std::string FeatureTracker::setParams(const TrackerParams& params) {
@@ -108,23 +110,39 @@ void FeatureTracker::applyPendingParams() {
   trim_to_max_ = trim_to_max_ || pending_params_->max_features < params_.max_features;
   params_ = *pending_params_;
   pending_params_.reset();
+  if (!params_.reidentify) {  // (what it kept would never be used nor forgotten)
+    descriptors_.clear();
+    lost_.clear();
+  }
 }
 
-// After max_features was lowered: the newest points beyond it go (current_ is oldest
-// first; the start-up target's corners stay), remembered as lost so that a later search
-// can give them their ids back. (Erasing keeps the others' prev_index: it points into
-// previous_.)
+// After max_features was lowered: the youngest points beyond it go (fewest images
+// tracked; the start-up target's corners stay), remembered as lost so that a later search
+// can give them their ids back. The loss that triggers a search counts from what is left.
+// (Dropping keeps the others' prev_index: it points into previous_.)
 void FeatureTracker::trimToMaxFeatures() {
   trim_to_max_ = false;
-  size_t excess = current_.size() > static_cast<size_t>(params_.max_features)
-                      ? current_.size() - static_cast<size_t>(params_.max_features)
-                      : 0;
-  for (size_t k = current_.size(); k-- > 0 && excess > 0;) {
-    if (current_[k].is_target_corner) continue;
-    rememberLost(current_[k]);
-    current_.erase(current_.begin() + static_cast<std::ptrdiff_t>(k));
-    --excess;
+  const size_t keep = static_cast<size_t>(params_.max_features);
+  if (current_.size() <= keep) return;
+  std::vector<size_t> order;
+  for (size_t k = 0; k < current_.size(); ++k)
+    if (!current_[k].is_target_corner) order.push_back(k);
+  // Youngest first; among equals the later (newer) one.
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return current_[a].age < current_[b].age || (current_[a].age == current_[b].age && a > b);
+  });
+  std::vector<bool> drop(current_.size(), false);
+  for (size_t k = 0; k < order.size() && k < current_.size() - keep; ++k) drop[order[k]] = true;
+  std::vector<TrackedPoint> kept;
+  kept.reserve(keep);
+  for (size_t k = 0; k < current_.size(); ++k) {
+    if (drop[k])
+      rememberLost(current_[k]);
+    else
+      kept.push_back(current_[k]);
   }
+  current_.swap(kept);
+  found_at_last_search_ = std::min(found_at_last_search_, static_cast<int>(current_.size()));
 }
 
 int minimumImageSide(const TrackerParams& params) {

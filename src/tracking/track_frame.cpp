@@ -15,6 +15,7 @@ TrackFrame trackFrameOf(const std::vector<TrackedPoint>& points, double stamp, c
     frame.ids.push_back(p.id);
     frame.pixels.emplace_back(p.uv.x, p.uv.y);
     frame.target_corner.push_back(p.is_target_corner);
+    frame.reidentified.push_back(p.is_reidentified);
   }
   return frame;
 }
@@ -25,9 +26,12 @@ std::string validateTrackFrame(const TrackFrame& frame) {
     why << "image size " << frame.size.width << "x" << frame.size.height << " is empty";
     return why.str();
   }
-  if (frame.pixels.size() != frame.ids.size() || frame.target_corner.size() != frame.ids.size()) {
+  if (frame.pixels.size() != frame.ids.size() || frame.target_corner.size() != frame.ids.size() ||
+      (!frame.reidentified.empty() && frame.reidentified.size() != frame.ids.size())) {
     why << "array lengths differ (" << frame.ids.size() << " ids, " << frame.pixels.size()
-        << " points, " << frame.target_corner.size() << " flags)";
+        << " points, " << frame.target_corner.size() << " flags";
+    if (!frame.reidentified.empty()) why << ", " << frame.reidentified.size() << " re-identified";
+    why << ")";
     return why.str();
   }
   std::unordered_set<std::uint64_t> seen;

@@ -182,6 +182,37 @@ TEST(PlanePipeline, ATrackerThatStartedOverStartsTheMapOver) {
   EXPECT_FALSE(r.was_reset);
 }
 
+// A tracker with one point left that loses it and finds it again under its old id (a
+// small max_features set live, hostile try): an old id, none of the last image's, but
+// re-identified: no restart. The same id not flagged re-identified is one.
+TEST(PlanePipeline, AReidentifiedOldIdIsNoRestart) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k < 90; ++k) {
+    TrackFrame f = world.frame(k / 30.0);
+    for (auto& id : f.ids) id += 1000;  // (so that ids 1-999 are old and in no image)
+    r = pipeline.process(f);
+  }
+  ASSERT_TRUE(r.pose) << r.status;
+  const std::uint64_t old_id = 5;
+  TrackFrame back = world.frame(90 / 30.0);
+  back.ids = {old_id};
+  back.pixels = {back.pixels.front()};
+  back.target_corner = {false};
+  back.reidentified = {true};
+  ASSERT_EQ(validateTrackFrame(back), "");
+  r = pipeline.process(back);
+  EXPECT_FALSE(r.was_reset);
+  EXPECT_FALSE(r.tracker_restarted);
+  back.stamp += 1 / 30.0;
+  back.ids = {old_id - 1};
+  back.reidentified.clear();  // (none flagged)
+  r = pipeline.process(back);
+  EXPECT_TRUE(r.tracker_restarted);
+}
+
 TEST(PlanePipeline, ImagePlaneIdsAreStable) {
   const SyntheticTracks world("wheeled");
   PlanePipeline pipeline;

@@ -1002,3 +1002,25 @@ TEST(TrackerFrontEnd, TrackerParamsChangeBetweenImagesOrAreRefused) {
   EXPECT_NE(front.setTrackerParams(other_pyramid), "");
   EXPECT_EQ(front.params().tracker.pyramid_levels, TrackerParams().pyramid_levels);
 }
+
+// Tracks -> TrackFrame: the flags the pipeline uses (the target's corners; re-identified
+// points, which are no sign of a tracker that started over).
+TEST(PlaneMessages, TracksFlagsReachTheFrame) {
+  Tracks msg;
+  msg.header.stamp = ros::Time(10, 0);
+  msg.width = 640;
+  msg.height = 480;
+  msg.id = {3, 8, 9};
+  msg.u = {10, 20, 30};
+  msg.v = {40, 50, 60};
+  msg.flags = {Tracks::FLAG_TRACKED, Tracks::FLAG_TARGET_CORNER | Tracks::FLAG_TRACKED,
+               Tracks::FLAG_REIDENTIFIED | Tracks::FLAG_NEW};
+  msg.prev_index = {0, 1, -1};
+  msg.age = {5, 5, 0};
+  std::string error;
+  const TrackFrame frame = toTrackFrame(msg, error);
+  EXPECT_EQ(error, "");
+  EXPECT_EQ(frame.target_corner, (std::vector<bool>{false, true, false}));
+  EXPECT_EQ(frame.reidentified, (std::vector<bool>{false, false, true}));
+  EXPECT_EQ(frame.ids, (std::vector<std::uint64_t>{3, 8, 9}));
+}

@@ -739,9 +739,10 @@ TEST(FeatureTracker, PredictedMotionWithoutTheCheckTracksAsExactly) {
   EXPECT_GE(predicted.score.errors().size(), full.score.errors().size() * 99 / 100);
 }
 
-// setParams (dynamic_reconfigure): a lower max_features drops the newest points on the next
-// image, the others keep their ids and tracks; a higher one is filled by the next search.
-TEST(FeatureTracker, ALowerMaxFeaturesDropsTheNewestPointsAndKeepsTheOthers) {
+// setParams (dynamic_reconfigure): a lower max_features drops the youngest points on the
+// next image (here all are as old: the newest ids), the others keep their ids and tracks,
+// and the drop triggers no search; a higher one is filled by the next search.
+TEST(FeatureTracker, ALowerMaxFeaturesDropsTheYoungestPointsAndKeepsTheOthers) {
   TrackerParams params;
   params.max_features = 100;
   FeatureTracker tracker(params);
@@ -757,6 +758,7 @@ TEST(FeatureTracker, ALowerMaxFeaturesDropsTheNewestPointsAndKeepsTheOthers) {
   EXPECT_EQ(tracker.params().max_features, 30);
   const auto& points = tracker.process(warpView(texture(), hs[2], kView));
   ASSERT_EQ(points.size(), 30u);
+  EXPECT_FALSE(tracker.lastStats().searched);  // (the loss counts from what is left)
   for (size_t i = 0; i < points.size(); ++i) {
     EXPECT_EQ(points[i].id, oldest[i]);
     EXPECT_TRUE(points[i].is_tracked);
@@ -835,4 +837,27 @@ TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
   }
   EXPECT_EQ(rest, 4);
   EXPECT_EQ(tracker.params().quality_level, 0.05);  // after its last image
+}
+
+// A reset takes the parameters waiting for a spread search at once (there is none left).
+TEST(FeatureTracker, ResetTakesWaitingParams) {
+  TrackerParams params;
+  params.max_features = 150;
+  params.search_spread_images = 5;
+  FeatureTracker tracker(params);
+  const auto hs = translations(40, kCentred, {4.0, 0.0});
+  size_t k = 0;
+  tracker.process(warpView(texture(), hs[k++], kView));
+  for (; k < hs.size(); ++k) {
+    tracker.process(warpView(texture(), hs[k], kView));
+    if (tracker.lastStats().searched) break;
+  }
+  ASSERT_LT(k, hs.size());
+  TrackerParams changed = params;
+  changed.max_features = 20;
+  ASSERT_EQ(tracker.setParams(changed), "");
+  EXPECT_EQ(tracker.params().max_features, 150);  // waits for the spread search
+  tracker.reset();
+  EXPECT_EQ(tracker.params().max_features, 20);
+  EXPECT_EQ(tracker.process(warpView(texture(), hs[0], kView)).size(), 20u);
 }

@@ -27,6 +27,11 @@ TEST(TrackFrame, NamesWhatIsWrong) {
   f.pixels.pop_back();
   EXPECT_NE(validateTrackFrame(f).find("array lengths differ"), std::string::npos);
   f = good();
+  f.reidentified = {true};  // (optional, but as long as the ids when given)
+  EXPECT_NE(validateTrackFrame(f).find("1 re-identified"), std::string::npos);
+  f.reidentified = {true, false, false};
+  EXPECT_EQ(validateTrackFrame(f), "");
+  f = good();
   f.pixels[1].x = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(validateTrackFrame(f).find("non-finite"), std::string::npos);
   f = good();
@@ -73,11 +78,13 @@ TEST(TrackFrame, TrackerPointsBecomeAFrame) {
   points[1].id = 9;
   points[1].uv = {30, 40};
   points[1].is_target_corner = true;
+  points[0].is_reidentified = true;
   const TrackFrame f = trackFrameOf(points, 12.5, {640, 480});
   EXPECT_EQ(f.stamp, 12.5);
   EXPECT_EQ(f.size, cv::Size(640, 480));
   EXPECT_EQ(f.ids, (std::vector<std::uint64_t>{7, 9}));
   EXPECT_EQ(f.pixels[0], cv::Point2d(10.5, 20.25));
   EXPECT_EQ(f.target_corner, (std::vector<bool>{false, true}));
+  EXPECT_EQ(f.reidentified, (std::vector<bool>{true, false}));
   EXPECT_EQ(validateTrackFrame(f), "");
 }

@@ -155,8 +155,8 @@ class FeatureTracker {
   // nothing changes. pyramid_levels, window_size_px and reanchor_window_px size the
   // pyramids and the smallest image: a change of those is refused (it needs a new
   // tracker). A spread search in progress finishes under the old values; the new ones
-  // apply from the image after it. A lower max_features drops the newest points beyond it
-  // on the next image (the start-up target's corners stay; the dropped ones can be
+  // apply from the image after it. A lower max_features drops the youngest points beyond
+  // it on the next image (the start-up target's corners stay; the dropped ones can be
   // re-identified later).
   std::string setParams(const TrackerParams& params);
 

@@ -17,6 +17,9 @@ struct TrackFrame {
   std::vector<std::uint64_t> ids;
   std::vector<cv::Point2d> pixels;
   std::vector<bool> target_corner;  // corner of the start-up target
+  // Got its id back from before it was lost (re-identification): an old id that is no
+  // sign of a tracker that started over. Empty: none is.
+  std::vector<bool> reidentified;
 };
 
 // The tracker's points of one image as a frame (what the tracker nodelet's Tracks message
