@@ -992,7 +992,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   static constexpr double kRetryS = 0.005;
   static constexpr size_t kMaxPending = 30;  // more waiting: the oldest goes without
   ros::ServiceServer reset_srv_, save_srv_;
-  ReconfigureBridge<PlanesConfig, PlaneNodeParams> reconfigure_;
   std::unique_ptr<image_transport::ImageTransport> image_transport_;
   image_transport::Publisher debug_pub_;
   image_transport::Subscriber image_sub_;
@@ -1052,6 +1051,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string map_frame_shared_;           // others' links into map_frame ("" when none)
   ros::WallTime shared_checked_;           // (checkMapFrameShared)
   std::set<std::string> published_edges_;  // links this nodelet has put on tf
+  // Last: destroyed first, so no reconfigure callback outlives what it locks and changes.
+  ReconfigureBridge<PlanesConfig, PlaneNodeParams> reconfigure_;
 };
 
 }  // namespace mono_plane_detection

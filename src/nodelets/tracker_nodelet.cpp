@@ -15,9 +15,9 @@
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
+#include "mono_plane_detection/TrackerConfig.h"
 #include "mono_plane_detection/viz/draw_tracks.h"
 #include "nodelet_diagnostics.h"
-#include "mono_plane_detection/TrackerConfig.h"
 #include "recent_events.h"
 #include "reconfigure_bridge.h"
 #include "ros_params.h"

@@ -564,27 +564,35 @@ std::string exactText(double value) {
   }
 }
 
+// What a .cfg file says of itself and where it goes.
+struct CfgFile {
+  std::string nodelet;  // the class, for the header comment
+  std::string node;     // gen.generate's node name
+  std::string when;     // when its values are taken
+  std::string name;     // cfg/<name>.cfg, the <name>Config class
+  std::string flag;     // param_table's flag that prints it
+  std::string test;     // the test that checks it
+  std::string example;  // a name with '/' and its .cfg form
+};
+
 // A dynamic_reconfigure .cfg for the runtime parameters `names` of one nodelet's table.
 template <typename P>
 std::string reconfigureCfg(const ParamTable<P>& table, const std::vector<std::string>& names,
-                           const std::string& nodelet, const std::string& node,
-                           const std::string& what,
-                           const std::string& file, const std::string& flag,
-                           const std::string& test, const std::string& example) {
+                           const CfgFile& file) {
   std::ostringstream out;
   out << "#!/usr/bin/env python3\n"
          "# "
-      << nodelet << "'s parameters that can change while it runs (" << what
+      << file.nodelet << "'s parameters that can change while it runs (" << file.when
       << ").\n"
          "# Generated from the parameter table (src/params/param_table.cpp) by\n"
          "# `rosrun mono_plane_detection param_table "
-      << flag << " > cfg/" << file
+      << file.flag << " > cfg/" << file.name
       << ".cfg`; do not edit by\n"
          "# hand ("
-      << test
+      << file.test
       << " fails when this file is out of date). Each name is the\n"
          "# table's with '/' -> '_' ("
-      << example
+      << file.example
       << ").\n"
          "PACKAGE = \"mono_plane_detection\"\n\n"
          "from dynamic_reconfigure.parameter_generator_catkin import ParameterGenerator, "
@@ -617,7 +625,7 @@ std::string reconfigureCfg(const ParamTable<P>& table, const std::vector<std::st
         value);
     out << ")\n";
   }
-  out << "\nexit(gen.generate(PACKAGE, \"" << node << "\", \"" << file
+  out << "\nexit(gen.generate(PACKAGE, \"" << file.node << "\", \"" << file.name
       << "\"))\n";
   return out.str();
 }
@@ -625,15 +633,27 @@ std::string reconfigureCfg(const ParamTable<P>& table, const std::vector<std::st
 }  // namespace
 
 std::string dynamicReconfigureCfg() {
-  return reconfigureCfg(planeNodeParamTable(), planeRuntimeParamNames(), "PlaneNodelet",
-                        "plane_nodelet", "read on every image", "Planes", "--cfg", "test_planes_cfg",
-                        "planes/vote_threshold_px: planes_vote_threshold_px");
+  CfgFile file;
+  file.nodelet = "PlaneNodelet";
+  file.node = "plane_nodelet";
+  file.when = "read on every image";
+  file.name = "Planes";
+  file.flag = "--cfg";
+  file.test = "test_planes_cfg";
+  file.example = "planes/vote_threshold_px: planes_vote_threshold_px";
+  return reconfigureCfg(planeNodeParamTable(), planeRuntimeParamNames(), file);
 }
 
 std::string trackerReconfigureCfg() {
-  return reconfigureCfg(trackerNodeParamTable(), trackerRuntimeParamNames(), "TrackerNodelet",
-                        "tracker_nodelet", "taken between images", "Tracker", "--tracker-cfg",
-                        "test_planes_cfg's TrackerCfg", "none of these has one");
+  CfgFile file;
+  file.nodelet = "TrackerNodelet";
+  file.node = "tracker_nodelet";
+  file.when = "taken between images";
+  file.name = "Tracker";
+  file.flag = "--tracker-cfg";
+  file.test = "test_planes_cfg's TrackerCfg";
+  file.example = "none of these has one";
+  return reconfigureCfg(trackerNodeParamTable(), trackerRuntimeParamNames(), file);
 }
 
 std::string parametersMarkdown() {

@@ -268,15 +268,14 @@ IndoorScene makeRoom(const RoomParams& params) {
   // order, tiled photo_tile_m wide: furnished or bare.
   int next_photo = 0;
   auto paintPhotos = [&](ScenePlane& p) {
-    if (params.photos.empty()) return false;
-    if (p.name != "floor" && p.name != "front_wall" && p.name != "left_wall") return false;
+    if (params.photos.empty()) return;
+    if (p.name != "floor" && p.name != "front_wall" && p.name != "left_wall") return;
     p.surface = "photo";
     const cv::Mat& photo = params.photos[next_photo++ % params.photos.size()];
     const double tile_h = params.photo_tile_m * photo.rows / photo.cols;
     for (double b = 0; b < p.height_m; b += tile_h)
       for (double a = 0; a < p.width_m; a += params.photo_tile_m)
         paintImage(p, photo, a, b, params.photo_tile_m);
-    return true;
   };
   int table_top = -1;
   if (!furnished) {

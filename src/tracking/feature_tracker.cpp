@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "mono_plane_detection/geometry/stats.h"
+#include "mono_plane_detection/params/param_table.h"
 
 namespace mono_plane_detection {
 namespace {
@@ -95,6 +96,9 @@ void FeatureTracker::reset() {
 }
 
 std::string FeatureTracker::setParams(const TrackerParams& params) {
+  TrackerParams checked = params;
+  if (const std::vector<std::string> errors = validate(checked); !errors.empty())
+    return "refused: " + errors.front();
   if (params.pyramid_levels != params_.pyramid_levels ||
       params.window_size_px != params_.window_size_px ||
       params.reanchor_window_px != params_.reanchor_window_px)
@@ -103,6 +107,13 @@ std::string FeatureTracker::setParams(const TrackerParams& params) {
   pending_params_ = params;
   if (spread_part_ == 0) applyPendingParams();
   return "";
+}
+
+// A lower max_features waiting for a spread search holds already for what it adds: its
+// corners would be dropped on the next image (review).
+int FeatureTracker::maxFeaturesNow() const {
+  return pending_params_ ? std::min(params_.max_features, pending_params_->max_features)
+                         : params_.max_features;
 }
 
 void FeatureTracker::applyPendingParams() {
@@ -141,7 +152,9 @@ void FeatureTracker::trimToMaxFeatures() {
     else
       kept.push_back(current_[k]);
   }
+  stats_.lost += static_cast<int>(current_.size() - kept.size());
   current_.swap(kept);
+  stats_.tracked = static_cast<int>(current_.size());
   found_at_last_search_ = std::min(found_at_last_search_, static_cast<int>(current_.size()));
 }
 
@@ -582,7 +595,7 @@ void FeatureTracker::continueSpreadSearch(const cv::Mat& gray,
   spread_image_ = -1;
   spread_part_ = 0;
   // Two points may have come closer since the search image: the spacing rule again.
-  const int wanted = params_.max_features - static_cast<int>(current_.size());
+  const int wanted = maxFeaturesNow() - static_cast<int>(current_.size());
   keepApart(followed, positionsOf(current_, live_uv_), params_.min_distance_px,
             std::max(0, wanted));
   adoptCorners(gray, followed);
@@ -603,7 +616,7 @@ void FeatureTracker::adoptCorners(const cv::Mat& gray, const std::vector<cv::Poi
       continue;
     }
     // Full: later corners are still checked, so `matched` counts every re-found point.
-    if (static_cast<int>(current_.size() + fresh.size()) >= params_.max_features) continue;
+    if (static_cast<int>(current_.size() + fresh.size()) >= maxFeaturesNow()) continue;
     TrackedPoint p;
     p.uv = corners[c];
     p.is_new = true;

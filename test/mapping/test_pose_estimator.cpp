@@ -231,19 +231,6 @@ TEST(PoseEstimator, AJumpIsRefusedUntilTheLastPoseIsForgotten) {
   const double t = 90 / 30.0;
   Pose aside = trajectoryPose(world.trajectory, t);
   aside.t += aside.R * cv::Vec3d(0.6, 0, 0);  // along the camera's x (right)
-  auto withoutTarget = [](TrackFrame f) {
-    TrackFrame out = f;
-    out.ids.clear();
-    out.pixels.clear();
-    out.target_corner.clear();
-    for (size_t i = 0; i < f.ids.size(); ++i) {
-      if (f.target_corner[i]) continue;
-      out.ids.push_back(f.ids[i]);
-      out.pixels.push_back(f.pixels[i]);
-      out.target_corner.push_back(false);
-    }
-    return out;
-  };
   EXPECT_FALSE(estimator.update(withoutTarget(world.frameAt(aside, 1000 + t))));
   estimator.forgetLastPose();
   const auto e = estimator.update(withoutTarget(world.frameAt(aside, 1000 + t + 1 / 30.0)));

@@ -81,11 +81,13 @@ inline TrackFrame withoutTarget(const TrackFrame& f) {
   out.ids.clear();
   out.pixels.clear();
   out.target_corner.clear();
+  out.reidentified.clear();
   for (size_t i = 0; i < f.ids.size(); ++i)
     if (!f.target_corner[i]) {
       out.ids.push_back(f.ids[i]);
       out.pixels.push_back(f.pixels[i]);
       out.target_corner.push_back(false);
+      if (!f.reidentified.empty()) out.reidentified.push_back(f.reidentified[i]);
     }
   return out;
 }

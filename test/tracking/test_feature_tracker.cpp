@@ -861,3 +861,68 @@ TEST(FeatureTracker, ResetTakesWaitingParams) {
   EXPECT_EQ(tracker.params().max_features, 20);
   EXPECT_EQ(tracker.process(warpView(texture(), hs[0], kView)).size(), 20u);
 }
+
+// Youngest first: points of different ages, the youngest go, whatever their place.
+TEST(FeatureTracker, ALowerMaxFeaturesDropsTheYoungestWhateverTheirPlace) {
+  TrackerParams params;
+  params.max_features = 60;
+  params.redetect_every = 3;  // new corners join every third image
+  FeatureTracker tracker(params);
+  const auto hs = translations(12, kCentred, {3.0, 0.0});  // points leave at the side
+  for (size_t k = 0; k < 7; ++k) tracker.process(warpView(texture(), hs[k], kView));
+  const auto before = tracker.current();
+  std::vector<int> ages;
+  for (const auto& p : before) ages.push_back(p.age);
+  ASSERT_GT(*std::max_element(ages.begin(), ages.end()), *std::min_element(ages.begin(), ages.end()));
+  const size_t keep = before.size() / 2;
+  params.max_features = static_cast<int>(keep);
+  ASSERT_EQ(tracker.setParams(params), "");
+  const auto& after = tracker.process(warpView(texture(), hs[7], kView));
+  ASSERT_LE(after.size(), keep);
+  // Every point kept is at least as old as every point dropped that was still followed.
+  int youngest_kept = 1 << 30;
+  std::set<std::uint64_t> kept;
+  for (const auto& p : after) {
+    kept.insert(p.id);
+    youngest_kept = std::min(youngest_kept, p.age - 1);  // (one image older now)
+  }
+  int oldest_dropped = -1;
+  for (const auto& p : before)
+    if (!kept.count(p.id)) oldest_dropped = std::max(oldest_dropped, p.age);
+  EXPECT_LE(oldest_dropped, youngest_kept);
+  EXPECT_EQ(tracker.lastStats().tracked, static_cast<int>(after.size()));
+}
+
+// Values out of their range are refused as the nodelets' parameters are (no OpenCV assert).
+TEST(FeatureTracker, SetParamsRefusesValuesOutOfRange) {
+  FeatureTracker tracker;
+  TrackerParams params;
+  params.block_size = 0;
+  EXPECT_NE(tracker.setParams(params).find("block_size"), std::string::npos);
+  EXPECT_EQ(tracker.params().block_size, TrackerParams().block_size);
+}
+
+// A lower max_features set while a spread search runs: the search adds no more than it.
+TEST(FeatureTracker, ASpreadSearchAddsNoMoreThanAWaitingLowerMax) {
+  TrackerParams params;
+  params.max_features = 150;
+  params.search_spread_images = 5;
+  FeatureTracker tracker(params);
+  const auto hs = translations(40, kCentred, {4.0, 0.0});
+  size_t k = 0;
+  tracker.process(warpView(texture(), hs[k++], kView));
+  for (; k < hs.size(); ++k) {
+    tracker.process(warpView(texture(), hs[k], kView));
+    if (tracker.lastStats().searched) break;
+  }
+  ASSERT_LT(k, hs.size());
+  const size_t live = tracker.current().size();
+  ASSERT_LT(live, 150u);
+  TrackerParams lower = params;
+  lower.max_features = static_cast<int>(live);
+  ASSERT_EQ(tracker.setParams(lower), "");
+  for (int rest = 0; rest < 4 && ++k < hs.size(); ++rest) {
+    const auto& points = tracker.process(warpView(texture(), hs[k], kView));
+    EXPECT_LE(points.size(), live) << "image " << k;
+  }
+}

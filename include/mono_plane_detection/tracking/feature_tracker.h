@@ -152,7 +152,7 @@ class FeatureTracker {
   void reset();
 
   // New parameters between images (dynamic_reconfigure); "" when taken, else why not and
-  // nothing changes. pyramid_levels, window_size_px and reanchor_window_px size the
+  // nothing changes (also a value out of its range, param_table.h). pyramid_levels, window_size_px and reanchor_window_px size the
   // pyramids and the smallest image: a change of those is refused (it needs a new
   // tracker). A spread search in progress finishes under the old values; the new ones
   // apply from the image after it. A lower max_features drops the youngest points beyond
@@ -219,6 +219,7 @@ class FeatureTracker {
   void adoptCorners(const cv::Mat& gray, const std::vector<cv::Point2f>& corners);
   void reanchor(const cv::Mat& gray);
   void applyPendingParams();
+  int maxFeaturesNow() const;
   void trimToMaxFeatures();
   void moveLostWithImage();
   void reidentify(const std::vector<cv::Mat>& descriptors, std::vector<TrackedPoint>& fresh);
