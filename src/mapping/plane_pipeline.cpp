@@ -127,7 +127,9 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
     // A re-identified point has its old id back: the tracker remembers what it lost, so
     // it did not start over (hostile try: one point left, lost, and found again under
-    // its old id, with max_features 1 set live, started the map over).
+    // its old id, with max_features 1 set live, started the map over). The flag is on
+    // one image only: should that message not reach the map and no other point be left,
+    // the next still looks like a restart (review; rare with tens of points).
     const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(),
                                      true) != frame.reidentified.end();
     if (!history_.empty() && newest < newest_id_ && !remembers) {
