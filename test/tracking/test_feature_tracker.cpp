@@ -809,21 +809,34 @@ TEST(FeatureTracker, SetParamsRefusesWhatSizesThePyramids) {
             50u);
 }
 
-// A spread search in progress finishes under the values it started with; the new ones
-// apply from the image after it.
-TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
+namespace {
+
+TrackerParams spreadOverFive() {
   TrackerParams params;
   params.max_features = 150;
   params.search_spread_images = 5;
+  return params;
+}
+
+// Processes hs until a spread search starts; returns that image's index (hs.size(): none).
+size_t runToASpreadSearch(FeatureTracker& tracker, const std::vector<cv::Matx33d>& hs) {
+  tracker.process(warpView(texture(), hs[0], kView));  // (the first searches whole)
+  for (size_t k = 1; k < hs.size(); ++k) {
+    tracker.process(warpView(texture(), hs[k], kView));
+    if (tracker.lastStats().searched) return k;
+  }
+  return hs.size();
+}
+
+}  // namespace
+
+// A spread search in progress finishes under the values it started with; the new ones
+// apply from the image after it.
+TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
+  const TrackerParams params = spreadOverFive();
   FeatureTracker tracker(params);
   const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
-  size_t k = 0;
-  tracker.process(warpView(texture(), hs[k++], kView));
-  // Up to the start of a spread search.
-  for (; k < hs.size(); ++k) {
-    tracker.process(warpView(texture(), hs[k], kView));
-    if (tracker.lastStats().searched) break;
-  }
+  size_t k = runToASpreadSearch(tracker, hs);
   ASSERT_LT(k, hs.size());
   TrackerParams changed = params;
   changed.quality_level = 0.05;
@@ -841,17 +854,10 @@ TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
 
 // A reset takes the parameters waiting for a spread search at once (there is none left).
 TEST(FeatureTracker, ResetTakesWaitingParams) {
-  TrackerParams params;
-  params.max_features = 150;
-  params.search_spread_images = 5;
+  const TrackerParams params = spreadOverFive();
   FeatureTracker tracker(params);
-  const auto hs = translations(40, kCentred, {4.0, 0.0});
-  size_t k = 0;
-  tracker.process(warpView(texture(), hs[k++], kView));
-  for (; k < hs.size(); ++k) {
-    tracker.process(warpView(texture(), hs[k], kView));
-    if (tracker.lastStats().searched) break;
-  }
+  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
+  size_t k = runToASpreadSearch(tracker, hs);
   ASSERT_LT(k, hs.size());
   TrackerParams changed = params;
   changed.max_features = 20;
@@ -904,17 +910,10 @@ TEST(FeatureTracker, SetParamsRefusesValuesOutOfRange) {
 
 // A lower max_features set while a spread search runs: the search adds no more than it.
 TEST(FeatureTracker, ASpreadSearchAddsNoMoreThanAWaitingLowerMax) {
-  TrackerParams params;
-  params.max_features = 150;
-  params.search_spread_images = 5;
+  const TrackerParams params = spreadOverFive();
   FeatureTracker tracker(params);
-  const auto hs = translations(40, kCentred, {4.0, 0.0});
-  size_t k = 0;
-  tracker.process(warpView(texture(), hs[k++], kView));
-  for (; k < hs.size(); ++k) {
-    tracker.process(warpView(texture(), hs[k], kView));
-    if (tracker.lastStats().searched) break;
-  }
+  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
+  size_t k = runToASpreadSearch(tracker, hs);
   ASSERT_LT(k, hs.size());
   const size_t live = tracker.current().size();
   ASSERT_LT(live, 150u);
