@@ -130,8 +130,8 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
     // its old id, with max_features 1 set live, started the map over). The flag is on
     // one image only: should that message not reach the map and no other point be left,
     // the next still looks like a restart (review; rare with tens of points).
-    const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(),
-                                     true) != frame.reidentified.end();
+    const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(), true) !=
+                           frame.reidentified.end();
     if (!history_.empty() && newest < newest_id_ && !remembers) {
       // (Checked whenever the newest track is gone, not only at restarts: a set, not a
       // search of the last image per id.)

@@ -625,8 +625,7 @@ std::string reconfigureCfg(const ParamTable<P>& table, const std::vector<std::st
         value);
     out << ")\n";
   }
-  out << "\nexit(gen.generate(PACKAGE, \"" << file.node << "\", \"" << file.name
-      << "\"))\n";
+  out << "\nexit(gen.generate(PACKAGE, \"" << file.node << "\", \"" << file.name << "\"))\n";
   return out.str();
 }
 

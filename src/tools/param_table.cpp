@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
                   "  Prints the parameter tables of both nodelets, the one declaration of every\n"
                   "  parameter (name, default, range, unit, meaning).",
                   "exit codes: 0 printed, 2 bad usage\n");
-  cli.flag("markdown", &markdown, "docs/parameters.md (param_table --markdown > docs/parameters.md)")
+  cli.flag("markdown", &markdown,
+           "docs/parameters.md (param_table --markdown > docs/parameters.md)")
       .flag("cfg", &cfg,
             "cfg/Planes.cfg, the plane nodelet's dynamic_reconfigure parameters (then chmod +x "
             "it)")

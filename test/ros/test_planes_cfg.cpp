@@ -3,12 +3,12 @@
 // has, for every runtime parameter, the table's type, default and range (issue 14: one
 // declaration per parameter).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <boost/any.hpp>
 #include <fstream>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/TrackerConfig.h"
@@ -26,9 +26,9 @@ void expectCommittedFileIsGenerated(const std::string& file, const std::string& 
   ASSERT_TRUE(in) << path << " missing";
   std::stringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(text.str(), generated) << "cfg/" << file << " is out of date: rosrun "
-                                   << "mono_plane_detection param_table " << flag << " > cfg/"
-                                   << file;
+  EXPECT_EQ(text.str(), generated)
+      << "cfg/" << file << " is out of date: rosrun "
+      << "mono_plane_detection param_table " << flag << " > cfg/" << file;
   // dynamic_reconfigure runs the file; regenerating it by redirection drops the bit.
   EXPECT_EQ(access(path.c_str(), X_OK), 0) << "cfg/" << file << " must be executable";
 }

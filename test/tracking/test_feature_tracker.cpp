@@ -879,7 +879,8 @@ TEST(FeatureTracker, ALowerMaxFeaturesDropsTheYoungestWhateverTheirPlace) {
   const auto before = tracker.current();
   std::vector<int> ages;
   for (const auto& p : before) ages.push_back(p.age);
-  ASSERT_GT(*std::max_element(ages.begin(), ages.end()), *std::min_element(ages.begin(), ages.end()));
+  ASSERT_GT(*std::max_element(ages.begin(), ages.end()),
+            *std::min_element(ages.begin(), ages.end()));
   const size_t keep = before.size() / 2;
   params.max_features = static_cast<int>(keep);
   ASSERT_EQ(tracker.setParams(params), "");

@@ -152,9 +152,10 @@ class FeatureTracker {
   void reset();
 
   // New parameters between images (dynamic_reconfigure); "" when taken, else why not and
-  // nothing changes (also a value out of its range, param_table.h). pyramid_levels, window_size_px and reanchor_window_px size the
-  // pyramids and the smallest image: a change of those is refused (it needs a new
-  // tracker). A spread search in progress finishes under the old values; the new ones
+  // nothing changes (also for a value out of its range, param_table.h). pyramid_levels,
+  // window_size_px and reanchor_window_px size the pyramids and the smallest image: a
+  // change of those is refused (it needs a new tracker). A spread search in progress
+  // finishes under the old values (a lower max_features caps what it adds); the new ones
   // apply from the image after it. A lower max_features drops the youngest points beyond
   // it on the next image (the start-up target's corners stay; the dropped ones can be
   // re-identified later).
