@@ -100,6 +100,32 @@ void PlanePipeline::reset() {
   previous_planes_.clear();
   motion_planes_.clear();
   newest_id_ = 0;
+  tracker_run_ = 0;
+}
+
+// A reloaded or respawned tracker: its points are none of the map's, whose landmarks
+// their ids name (hostile try: "lost" for the rest of the bag).
+bool PlanePipeline::trackerStartedOver(const TrackFrame& frame) const {
+  if (history_.empty()) return false;
+  // Said by the tracker (Tracks.tracker_run): another run is another tracker.
+  if (frame.tracker_run != 0 && tracker_run_ != 0) return frame.tracker_run != tracker_run_;
+  // Not said: a new tracker numbers from 1 again, so its newest id is below the newest
+  // seen and none of the last image's ids is left. A re-identified point has its old id
+  // back: the tracker remembers what it lost, so it did not start over (hostile try: one
+  // point left, lost, and found again under its old id, with max_features 1 set live,
+  // started the map over). The flag is on one image only: should that message not reach
+  // the map and no other point be left, the next still looks like a restart (review).
+  if (frame.ids.empty()) return false;
+  const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
+  const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(), true) !=
+                         frame.reidentified.end();
+  if (newest >= newest_id_ || remembers) return false;
+  // (Checked whenever the newest track is gone, not only at restarts: a set, not a search
+  // of the last image per id.)
+  const std::vector<std::uint64_t>& last_ids = history_.back().frame.ids;
+  const std::unordered_set<std::uint64_t> last(last_ids.begin(), last_ids.end());
+  return std::none_of(frame.ids.begin(), frame.ids.end(),
+                      [&](std::uint64_t id) { return last.count(id) > 0; });
 }
 
 PipelineResult PlanePipeline::process(const TrackFrame& frame,
@@ -123,29 +149,13 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       result.missing_images = stream_.add(since_ns);
     }
   }
-  if (!frame.ids.empty()) {
-    const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
-    // A re-identified point has its old id back: the tracker remembers what it lost, so
-    // it did not start over (hostile try: one point left, lost, and found again under
-    // its old id, with max_features 1 set live, started the map over). The flag is on
-    // one image only: should that message not reach the map and no other point be left,
-    // the next still looks like a restart (review; rare with tens of points).
-    const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(), true) !=
-                           frame.reidentified.end();
-    if (!history_.empty() && newest < newest_id_ && !remembers) {
-      // (Checked whenever the newest track is gone, not only at restarts: a set, not a
-      // search of the last image per id.)
-      const std::vector<std::uint64_t>& last_ids = history_.back().frame.ids;
-      const std::unordered_set<std::uint64_t> last(last_ids.begin(), last_ids.end());
-      const bool none_left = std::none_of(frame.ids.begin(), frame.ids.end(),
-                                          [&](std::uint64_t id) { return last.count(id) > 0; });
-      if (none_left) {
-        reset();
-        result.was_reset = result.tracker_restarted = true;
-      }
-    }
-    newest_id_ = std::max(newest_id_, newest);
+  if (trackerStartedOver(frame)) {
+    reset();
+    result.was_reset = result.tracker_restarted = true;
   }
+  if (!frame.ids.empty())
+    newest_id_ = std::max(newest_id_, *std::max_element(frame.ids.begin(), frame.ids.end()));
+  if (frame.tracker_run != 0) tracker_run_ = frame.tracker_run;
 
   if (pose_) result.pose = pose_->update(frame, odom_from_camera);
 

@@ -25,6 +25,7 @@ TrackFrame toTrackFrame(const Tracks& msg, std::string& error) {
     return frame;
   }
   frame.stamp = msg.header.stamp.toSec();
+  frame.tracker_run = msg.tracker_run;
   frame.size = cv::Size(static_cast<int>(msg.width), static_cast<int>(msg.height));
   frame.ids.assign(msg.id.begin(), msg.id.end());
   frame.pixels.reserve(n);

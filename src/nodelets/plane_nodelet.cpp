@@ -723,8 +723,9 @@ class PlaneNodelet : public nodelet::Nodelet {
         if (result.tracker_restarted) {
           // A reloaded or respawned tracker: its new tracks are no points of this map.
           NODELET_WARN(
-              "the tracker started over (its track ids began again, none of the last "
-              "image's left: a reloaded or respawned tracker nodelet?): the map starts over%s",
+              "the tracker started over (another tracker_run in its tracks, or its track ids "
+              "began again with none of the last image's left: a reloaded or respawned "
+              "tracker nodelet?): the map starts over%s",
               node_.pipeline.pose.metric_source == "target"
                   ? "; show the start-up target to the camera again"
                   : "");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <sstream>
 
 #include "camera_info_check.h"
@@ -11,9 +12,10 @@ namespace {
 
 TracksPtr toMessage(const std_msgs::Header& header, const cv::Size& size,
                     const std::vector<TrackedPoint>& points, bool searched,
-                    const TargetParams& target) {
+                    const TargetParams& target, std::uint32_t run) {
   TracksPtr msg(new Tracks);
   msg->header = header;
+  msg->tracker_run = run;
   msg->width = size.width;
   msg->height = size.height;
   msg->searched = searched;
@@ -49,10 +51,18 @@ std::string seconds(uint64_t ns) {
   return out.str();
 }
 
+// A run number for this tracker's Tracks (Tracks.tracker_run): random, never 0.
+std::uint32_t drawRun() {
+  std::random_device device;
+  std::uint32_t run = 0;
+  while (run == 0) run = device();
+  return run;
+}
+
 }  // namespace
 
 TrackerFrontEnd::TrackerFrontEnd(const TrackerNodeParams& params)
-    : params_(params), tracker_(params.tracker), target_startup_(params.target) {
+    : params_(params), tracker_(params.tracker), target_startup_(params.target), run_(drawRun()) {
   validate(params_);  // callers have reported the errors; never run on bad values
   tracker_ = FeatureTracker(params_.tracker);
   target_startup_ = TargetStartup(params_.target);
@@ -289,8 +299,8 @@ TrackerOutput TrackerFrontEnd::process(const sensor_msgs::ImageConstPtr& msg) {
   counts_.searches += stats.searched ? 1 : 0;
   counts_.lost += stats.lost;
   counts_.tracked_now = static_cast<int>(tracker_.current().size());
-  out.tracks =
-      toMessage(msg->header, image.size(), tracker_.current(), stats.searched, params_.target);
+  out.tracks = toMessage(msg->header, image.size(), tracker_.current(), stats.searched,
+                         params_.target, run_);
   return out;
 }
 

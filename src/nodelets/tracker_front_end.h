@@ -96,11 +96,14 @@ class TrackerFrontEnd {
   // Past target_timeout_s without a target while images arrive.
   bool targetOverdue() const;
   const TrackerNodeParams& params() const { return params_; }
+  // Tracks.tracker_run of every message: random, never 0, another for another front end.
+  std::uint32_t run() const { return run_; }
 
  private:
   TrackerNodeParams params_;
   FeatureTracker tracker_;
   TargetStartup target_startup_;
+  std::uint32_t run_;  // Tracks.tracker_run: drawn once per front end, kept over reset()
   // The stream's rhythm: every message heard of it, also one dropped as bad (hear()).
   void hear(uint64_t stamp_ns);
   void startOver(uint64_t stamp_ns, bool new_rhythm);

@@ -213,6 +213,41 @@ TEST(PlanePipeline, AReidentifiedOldIdIsNoRestart) {
   EXPECT_TRUE(r.tracker_restarted);
 }
 
+// A tracker that says its run (Tracks.tracker_run): another run is a restart whatever the
+// ids (here still above the old ones); the same run is none whatever they are (all
+// lost, the one left an old id that is neither flagged nor in the last image).
+TEST(PlanePipeline, TheTrackersRunTellsARestart) {
+  const SyntheticTracks world("wheeled");
+  PlanePipeline pipeline;
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k < 90; ++k) {
+    TrackFrame f = world.frame(k / 30.0);
+    for (auto& id : f.ids) id += 1000;
+    f.tracker_run = 7;
+    r = pipeline.process(f);
+  }
+  ASSERT_TRUE(r.pose) << r.status;
+  TrackFrame same = world.frame(90 / 30.0);
+  same.ids = {5};
+  same.pixels = {same.pixels.front()};
+  same.target_corner = {false};
+  same.tracker_run = 7;
+  r = pipeline.process(same);
+  EXPECT_FALSE(r.tracker_restarted);
+  TrackFrame other = world.frame(91 / 30.0);
+  for (auto& id : other.ids) id += 100000;  // (ids above the old: the id rule says no)
+  other.tracker_run = 8;
+  r = pipeline.process(other);
+  EXPECT_TRUE(r.tracker_restarted);
+  EXPECT_TRUE(r.was_reset);
+  TrackFrame next = world.frame(92 / 30.0);
+  for (auto& id : next.ids) id += 100000;
+  next.tracker_run = 8;
+  r = pipeline.process(next);
+  EXPECT_FALSE(r.tracker_restarted);
+}
+
 TEST(PlanePipeline, ImagePlaneIdsAreStable) {
   const SyntheticTracks world("wheeled");
   PlanePipeline pipeline;

@@ -1023,4 +1023,25 @@ TEST(PlaneMessages, TracksFlagsReachTheFrame) {
   EXPECT_EQ(frame.target_corner, (std::vector<bool>{false, true, false}));
   EXPECT_EQ(frame.reidentified, (std::vector<bool>{false, false, true}));
   EXPECT_EQ(frame.ids, (std::vector<std::uint64_t>{3, 8, 9}));
+  EXPECT_EQ(frame.tracker_run, 0u);  // not said
+  msg.tracker_run = 1234;
+  EXPECT_EQ(toTrackFrame(msg, error).tracker_run, 1234u);
+}
+
+// Every message of one tracker says the same run, never 0; another tracker another
+// (a reloaded or respawned nodelet), also after ~reset the same.
+TEST(TrackerFrontEnd, TracksSayTheTrackersRun) {
+  TrackerFrontEnd front, other;
+  const cv::Mat grey = textured({320, 240});
+  const TrackerOutput a = front.process(image(grey, 100));
+  const TrackerOutput b = front.process(image(grey, 100, 100000000));
+  ASSERT_TRUE(a.tracks && b.tracks);
+  EXPECT_NE(a.tracks->tracker_run, 0u);
+  EXPECT_EQ(a.tracks->tracker_run, b.tracks->tracker_run);
+  EXPECT_EQ(a.tracks->tracker_run, front.run());
+  front.reset();
+  const TrackerOutput c = front.process(image(grey, 101));
+  ASSERT_TRUE(c.tracks);
+  EXPECT_EQ(c.tracks->tracker_run, a.tracks->tracker_run);
+  EXPECT_NE(other.run(), front.run());  // (2^-32 by chance)
 }

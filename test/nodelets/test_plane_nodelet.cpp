@@ -1358,6 +1358,25 @@ TEST_F(PlaneNodeletTest, T_ATargetSeenBeforeCameraInfoIsAWarning) {
       << diagnostics.value("problem: start-up target") << " / " << diagnostics.message();
 }
 
+// Tracks that say the tracker's run (Tracks.tracker_run, as TrackerNodelet's do): another
+// run is a reloaded or respawned tracker, even with the same ids, and the map starts over
+// once, counted in diagnostics.
+TEST_F(PlaneNodeletTest, U_AnotherTrackerRunStartsTheMapOver) {
+  DiagnosticsProbe diagnostics(nh_, "plane_detector: planes");
+  ASSERT_TRUE(diagnostics.waitFresh());
+  const long before = diagnostics.number("resets: the tracker started over (total)");
+  for (int k = 0; k < 6; ++k) {
+    TrackFrame f = world_->frame(k / 30.0);
+    f.stamp += 8500;  // after every earlier test's stamps for this nodelet
+    TracksPtr msg = toTracks(f);
+    msg->tracker_run = k < 4 ? 11 : 12;
+    ASSERT_TRUE(send(msg)) << k;
+  }
+  ASSERT_TRUE(diagnostics.waitFresh());
+  ASSERT_TRUE(diagnostics.waitFresh());
+  EXPECT_EQ(diagnostics.number("resets: the tracker started over (total)") - before, 1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {

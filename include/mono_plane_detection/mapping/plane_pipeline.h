@@ -135,6 +135,7 @@ class PlanePipeline {
   void reset();
 
  private:
+  bool trackerStartedOver(const TrackFrame& frame) const;
   void assignImageIds(std::vector<ImagePlane>& planes);
   // motion_plane_images: replaces the observation of each image plane with too few
   // landmarks by its tracks on the fused plane from motion, once that is known well.
@@ -172,6 +173,7 @@ class PlanePipeline {
 
   std::deque<PastFrame> history_;
   std::uint64_t newest_id_ = 0;  // the largest track id seen since the last reset
+  std::uint32_t tracker_run_ = 0;  // TrackFrame::tracker_run since the last reset (0: none)
   GapCounter stream_;            // the tracks' rhythm: what counts as a pause
   std::vector<ImagePlane> previous_planes_;
   int next_image_id_ = 1;

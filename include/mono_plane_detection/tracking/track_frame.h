@@ -20,6 +20,9 @@ struct TrackFrame {
   // Got its id back from before it was lost (re-identification): an old id that is no
   // sign of a tracker that started over. Empty: none is.
   std::vector<bool> reidentified;
+  // The tracker's run (Tracks.tracker_run): another one is a tracker that started over
+  // (reloaded, respawned). 0: not said.
+  std::uint32_t tracker_run = 0;
 };
 
 // The tracker's points of one image as a frame (what the tracker nodelet's Tracks message
