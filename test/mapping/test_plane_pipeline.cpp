@@ -182,25 +182,44 @@ TEST(PlanePipeline, ATrackerThatStartedOverStartsTheMapOver) {
   EXPECT_FALSE(r.was_reset);
 }
 
+namespace {
+
+// 90 images of the wheeled room with ids from 1000 on (ids 1-999 are old and in no image)
+// and the tracker's run `run`; the camera placed.
+PipelineResult placedWithIdsFrom1000(PlanePipeline& pipeline, const SyntheticTracks& world,
+                                     std::uint32_t run) {
+  pipeline.setCamera(world.camera.K(), world.camera.distortion());
+  PipelineResult r;
+  for (int k = 0; k < 90; ++k) {
+    TrackFrame f = world.frame(k / 30.0);
+    for (auto& id : f.ids) id += 1000;
+    f.tracker_run = run;
+    r = pipeline.process(f);
+  }
+  return r;
+}
+
+// Image 90 with one point left, under this id.
+TrackFrame onePointLeft(const SyntheticTracks& world, std::uint64_t id) {
+  TrackFrame f = world.frame(90 / 30.0);
+  f.ids = {id};
+  f.pixels = {f.pixels.front()};
+  f.target_corner = {false};
+  return f;
+}
+
+}  // namespace
+
 // A tracker with one point left that loses it and finds it again under its old id (a
 // small max_features set live, hostile try): an old id, none of the last image's, but
 // re-identified: no restart. The same id not flagged re-identified is one.
 TEST(PlanePipeline, AReidentifiedOldIdIsNoRestart) {
   const SyntheticTracks world("wheeled");
   PlanePipeline pipeline;
-  pipeline.setCamera(world.camera.K(), world.camera.distortion());
-  PipelineResult r;
-  for (int k = 0; k < 90; ++k) {
-    TrackFrame f = world.frame(k / 30.0);
-    for (auto& id : f.ids) id += 1000;  // (so that ids 1-999 are old and in no image)
-    r = pipeline.process(f);
-  }
+  PipelineResult r = placedWithIdsFrom1000(pipeline, world, 0);
   ASSERT_TRUE(r.pose) << r.status;
   const std::uint64_t old_id = 5;
-  TrackFrame back = world.frame(90 / 30.0);
-  back.ids = {old_id};
-  back.pixels = {back.pixels.front()};
-  back.target_corner = {false};
+  TrackFrame back = onePointLeft(world, old_id);
   back.reidentified = {true};
   ASSERT_EQ(validateTrackFrame(back), "");
   r = pipeline.process(back);
@@ -219,19 +238,9 @@ TEST(PlanePipeline, AReidentifiedOldIdIsNoRestart) {
 TEST(PlanePipeline, TheTrackersRunTellsARestart) {
   const SyntheticTracks world("wheeled");
   PlanePipeline pipeline;
-  pipeline.setCamera(world.camera.K(), world.camera.distortion());
-  PipelineResult r;
-  for (int k = 0; k < 90; ++k) {
-    TrackFrame f = world.frame(k / 30.0);
-    for (auto& id : f.ids) id += 1000;
-    f.tracker_run = 7;
-    r = pipeline.process(f);
-  }
+  PipelineResult r = placedWithIdsFrom1000(pipeline, world, 7);
   ASSERT_TRUE(r.pose) << r.status;
-  TrackFrame same = world.frame(90 / 30.0);
-  same.ids = {5};
-  same.pixels = {same.pixels.front()};
-  same.target_corner = {false};
+  TrackFrame same = onePointLeft(world, 5);
   same.tracker_run = 7;
   r = pipeline.process(same);
   EXPECT_FALSE(r.tracker_restarted);
