@@ -214,7 +214,8 @@ class PlaneNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(mutex_);
     PlaneNodeParams node = node_;
     reconfigure_.read(config, node);
-    const std::vector<std::string> errors = validate(node);
+    std::vector<std::string> errors = reconfigure_.keepInUse(node, node_);
+    for (std::string& e : validate(node)) errors.push_back(std::move(e));  // (the others)
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
     reconfigure_errors_ = errors;
     if (!errors.empty()) reconfigure_.writeBack(node, config);

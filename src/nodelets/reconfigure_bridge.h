@@ -76,9 +76,32 @@ class ReconfigureBridge {
     }
   }
 
-  // The values in use, after validate() repaired what was refused, written back into the
-  // config: the server then reports and stores them (it showed a NaN the nodelet had
-  // replaced by the default).
+  // A value out of its range (dynamic_reconfigure clamps to the .cfg's range but lets a
+  // NaN through) is refused and the value in use kept: a bad input is dropped, the state
+  // kept. One message per refused parameter.
+  std::vector<std::string> keepInUse(NodeParams& node, const NodeParams& in_use) const {
+    std::vector<std::string> errors;
+    NodeParams before = in_use;
+    for (const auto& [flat, name] : cfg_names_) {
+      const auto* spec = findParam(*table_, name);
+      if (!spec) continue;
+      std::string error = rangeError(*spec, spec->field(node));
+      if (error.empty()) continue;
+      const ParamField kept = spec->field(before);
+      std::visit(
+          [&](auto* target) {
+            using T = std::remove_pointer_t<decltype(target)>;
+            *target = *std::get<T*>(kept);
+          },
+          spec->field(node));
+      errors.push_back(error + "; keeping " + toString(kept));
+    }
+    return errors;
+  }
+
+  // The values in use, after keepInUse() and validate() repaired what was refused,
+  // written back into the config: the server then reports and stores them (it showed a
+  // NaN the nodelet had refused).
   void writeBack(const NodeParams& node, Config& config) const {
     NodeParams values = node;
     dynamic_reconfigure::Config message;

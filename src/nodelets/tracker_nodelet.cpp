@@ -90,7 +90,8 @@ class TrackerNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(state_mutex_);
     TrackerNodeParams node = front_.params();
     reconfigure_.read(config, node);
-    std::vector<std::string> errors = validate(node);
+    std::vector<std::string> errors = reconfigure_.keepInUse(node, front_.params());
+    for (std::string& e : validate(node)) errors.push_back(std::move(e));  // (the others)
     // (Only the tracker's runtime parameters are in the .cfg: FeatureTracker takes them.)
     if (const std::string refused = front_.setTrackerParams(node.tracker); !refused.empty())
       errors.push_back(refused);

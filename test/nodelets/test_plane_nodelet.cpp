@@ -1055,8 +1055,8 @@ TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
   setMaxPlanes(8);
   EXPECT_GE(planesNow(5.0, 4000), 2u);
   std::printf("image planes: %zu, with planes_max_planes 1: %zu\n", before, capped);
-  // A value the nodelet refuses (NaN) is replaced by the default, and the server reports
-  // the value in use, not the one refused.
+  // A value the nodelet refuses (NaN) leaves the value in use, and the server reports it,
+  // not the one refused.
   dynamic_reconfigure::Reconfigure nan_gap;
   dynamic_reconfigure::DoubleParameter gap;
   gap.name = "max_gap_s";
@@ -1067,7 +1067,7 @@ TEST_F(PlaneNodeletTest, O_ReconfigureChangesTheNextImage) {
   for (const auto& d : nan_gap.response.config.doubles)
     if (d.name == "max_gap_s") {
       reported = true;
-      EXPECT_EQ(d.value, 1.0);  // the default (docs/parameters.md)
+      EXPECT_EQ(d.value, 1.0);  // the value in use (config/planes.yaml)
     }
   EXPECT_TRUE(reported);
   double stored = 0;

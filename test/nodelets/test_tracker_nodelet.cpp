@@ -757,7 +757,8 @@ TEST_F(TrackerNodeletTest, AFailedStartLeavesTheManagerRunning) {
 
 // dynamic_reconfigure (cfg/Tracker.cfg): max_features 20 leaves the 20 oldest points on the
 // next image, tracked on with their ids; back to 40, the next search fills up to it. A NaN
-// quality_level is refused: the default is used and reported, diagnostics name it.
+// quality_level is refused: the value in use (0.02) is kept and reported, diagnostics name
+// it.
 TEST_F(TrackerNodeletTest, ZReconfigureChangesTheNextImages) {
   auto set = [&](const std::string& name, double value, bool integer) {
     dynamic_reconfigure::Reconfigure srv;
@@ -801,12 +802,13 @@ TEST_F(TrackerNodeletTest, ZReconfigureChangesTheNextImages) {
   }
   EXPECT_EQ(most, 40u);
 
+  set("quality_level", 0.02, false);
   const auto answer = set("quality_level", std::numeric_limits<double>::quiet_NaN(), false);
   bool reported = false;
   for (const auto& d : answer.doubles)
     if (d.name == "quality_level") {
       reported = true;
-      EXPECT_EQ(d.value, 0.01);  // the default (docs/parameters.md)
+      EXPECT_EQ(d.value, 0.02);  // the value in use, not the default 0.01
     }
   EXPECT_TRUE(reported);
   EXPECT_TRUE(send(makeImage(view({x += 1.0, 0}), "mono8", stamp_ += 0.1)));  // tracking goes on
@@ -816,7 +818,9 @@ TEST_F(TrackerNodeletTest, ZReconfigureChangesTheNextImages) {
   EXPECT_NE(diagnostics.value("problem: configuration").find("reconfigure: quality_level = nan"),
             std::string::npos)
       << diagnostics.value("problem: configuration");
-  EXPECT_EQ(diagnostics.number("reconfigurations (total)"), 3);  // (not the server's start)
+  EXPECT_NE(diagnostics.value("problem: configuration").find("keeping 0.02"), std::string::npos)
+      << diagnostics.value("problem: configuration");
+  EXPECT_EQ(diagnostics.number("reconfigurations (total)"), 4);  // (not the server's start)
   set("quality_level", 0.01, false);
   set("max_features", 50, true);
   ASSERT_TRUE(diagnostics.waitFresh());
