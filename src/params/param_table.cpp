@@ -18,6 +18,9 @@ std::string toString(const ParamField& value) {
         } else if constexpr (std::is_same_v<T, std::string>) {
           return "\"" + *v + "\"";
         } else {
+          // (A NaN is "nan" whatever its sign bit: rosservice's .nan printed "-nan".)
+          if constexpr (std::is_floating_point_v<T>)
+            if (std::isnan(*v)) return "nan";
           std::ostringstream out;
           out << *v;
           return out.str();

@@ -11,6 +11,7 @@
 #include <dirent.h>
 
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -188,6 +189,8 @@ TEST(ParamTable, FieldValuesAsText) {
   EXPECT_EQ(toString(ParamField(&i)), "-3");
   EXPECT_EQ(toString(ParamField(&d)), "0.25");
   EXPECT_EQ(toString(ParamField(&s)), "\"odom\"");
+  double nan = -std::numeric_limits<double>::quiet_NaN();  // (sign bit set)
+  EXPECT_EQ(toString(ParamField(&nan)), "nan");
 }
 
 // The hostile new-user try: map_frame "" was taken and put on tf as a frame named "".
