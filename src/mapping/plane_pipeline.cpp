@@ -105,7 +105,7 @@ void PlanePipeline::reset() {
 
 // A reloaded or respawned tracker: its points are none of the map's, whose landmarks
 // their ids name (hostile try: "lost" for the rest of the bag).
-bool PlanePipeline::trackerStartedOver(const TrackFrame& frame) const {
+bool PlanePipeline::trackerStartedOver(const TrackFrame& frame, std::uint64_t newest) const {
   if (history_.empty()) return false;
   // Said by the tracker (Tracks.tracker_run): another run is another tracker.
   if (frame.tracker_run != 0 && tracker_run_ != 0) return frame.tracker_run != tracker_run_;
@@ -116,7 +116,6 @@ bool PlanePipeline::trackerStartedOver(const TrackFrame& frame) const {
   // started the map over). The flag is on one image only: should that message not reach
   // the map and no other point be left, the next still looks like a restart (review).
   if (frame.ids.empty()) return false;
-  const std::uint64_t newest = *std::max_element(frame.ids.begin(), frame.ids.end());
   const bool remembers = std::find(frame.reidentified.begin(), frame.reidentified.end(), true) !=
                          frame.reidentified.end();
   if (newest >= newest_id_ || remembers) return false;
@@ -149,12 +148,13 @@ PipelineResult PlanePipeline::process(const TrackFrame& frame,
       result.missing_images = stream_.add(since_ns);
     }
   }
-  if (trackerStartedOver(frame)) {
+  const std::uint64_t newest =
+      frame.ids.empty() ? 0 : *std::max_element(frame.ids.begin(), frame.ids.end());
+  if (trackerStartedOver(frame, newest)) {
     reset();
     result.was_reset = result.tracker_restarted = true;
   }
-  if (!frame.ids.empty())
-    newest_id_ = std::max(newest_id_, *std::max_element(frame.ids.begin(), frame.ids.end()));
+  newest_id_ = std::max(newest_id_, newest);
   if (frame.tracker_run != 0) tracker_run_ = frame.tracker_run;
 
   if (pose_) result.pose = pose_->update(frame, odom_from_camera);

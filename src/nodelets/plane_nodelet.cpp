@@ -212,13 +212,10 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   void onReconfigure(PlanesConfig& config, bool first) {
     std::lock_guard<std::mutex> lock(mutex_);
-    PlaneNodeParams node = node_;
-    reconfigure_.read(config, node);
-    std::vector<std::string> errors = reconfigure_.keepInUse(node, node_);
-    for (std::string& e : validate(node)) errors.push_back(std::move(e));  // (the others)
+    PlaneNodeParams node;
+    const std::vector<std::string> errors = reconfigure_.take(config, node_, node);
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
     reconfigure_errors_ = errors;
-    if (!errors.empty()) reconfigure_.writeBack(node, config);
     node_ = node;
     params_ = node.pipeline;
     pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);

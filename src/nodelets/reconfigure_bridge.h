@@ -76,30 +76,21 @@ class ReconfigureBridge {
     }
   }
 
-  // A value out of its range (dynamic_reconfigure clamps to the .cfg's range but lets a
-  // NaN through) is refused and the value in use kept: a bad input is dropped, the state
-  // kept. One message per refused parameter.
-  std::vector<std::string> keepInUse(NodeParams& node, const NodeParams& in_use) const {
-    std::vector<std::string> errors;
-    NodeParams before = in_use;
-    for (const auto& [flat, name] : cfg_names_) {
-      const auto* spec = findParam(*table_, name);
-      if (!spec) continue;
-      std::string error = rangeError(*spec, spec->field(node));
-      if (error.empty()) continue;
-      const ParamField kept = spec->field(before);
-      std::visit(
-          [&](auto* target) {
-            using T = std::remove_pointer_t<decltype(target)>;
-            *target = *std::get<T*>(kept);
-          },
-          spec->field(node));
-      errors.push_back(error + "; keeping " + toString(kept));
-    }
+  // The config's values over `node` (in_use's, as the nodelet runs now), checked: a value
+  // out of its range (dynamic_reconfigure clamps to the .cfg's range but lets a NaN
+  // through) keeps the value in use, then the node's own checks (validate(NodeParams&)).
+  // What was refused is written back into the config, so that the server reports the
+  // values in use. Returns one message per refusal.
+  std::vector<std::string> take(Config& config, const NodeParams& in_use, NodeParams& node) const {
+    node = in_use;
+    read(config, node);
+    std::vector<std::string> errors = validate(node, *table_, in_use, "keeping");
+    for (std::string& e : validate(node)) errors.push_back(std::move(e));
+    if (!errors.empty()) writeBack(node, config);
     return errors;
   }
 
-  // The values in use, after keepInUse() and validate() repaired what was refused,
+  // The values in use, after take()'s checks repaired what was refused,
   // written back into the config: the server then reports and stores them (it showed a
   // NaN the nodelet had refused).
   void writeBack(const NodeParams& node, Config& config) const {

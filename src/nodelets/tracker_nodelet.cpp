@@ -88,16 +88,15 @@ class TrackerNodelet : public nodelet::Nodelet {
 
   void onReconfigure(TrackerConfig& config, bool first) {
     std::lock_guard<std::mutex> lock(state_mutex_);
-    TrackerNodeParams node = front_.params();
-    reconfigure_.read(config, node);
-    std::vector<std::string> errors = reconfigure_.keepInUse(node, front_.params());
-    for (std::string& e : validate(node)) errors.push_back(std::move(e));  // (the others)
+    TrackerNodeParams node;
+    std::vector<std::string> errors = reconfigure_.take(config, front_.params(), node);
     // (Only the tracker's runtime parameters are in the .cfg: FeatureTracker takes them.)
-    if (const std::string refused = front_.setTrackerParams(node.tracker); !refused.empty())
+    if (const std::string refused = front_.setTrackerParams(node.tracker); !refused.empty()) {
       errors.push_back(refused);
+      reconfigure_.writeBack(front_.params(), config);
+    }
     for (const std::string& error : errors) NODELET_ERROR("reconfigure: %s", error.c_str());
     reconfigure_errors_ = errors;
-    if (!errors.empty()) reconfigure_.writeBack(front_.params(), config);
     if (!first) ++reconfigures_;
   }
 

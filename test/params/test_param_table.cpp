@@ -133,6 +133,21 @@ TEST(ParamTable, ValidateRepairsOutOfRangeValuesAndSaysWhy) {
   EXPECT_EQ(p.max_features, 150);
 }
 
+// While a nodelet runs (dynamic_reconfigure) a refused value keeps the value in use.
+TEST(ParamTable, ValidateAgainstTheValuesInUseKeepsThem) {
+  TrackerParams in_use;
+  in_use.quality_level = 0.02;
+  TrackerParams p = in_use;
+  p.quality_level = std::nan("");
+  p.max_features = 150;  // valid: taken
+  const auto errors = validate(p, trackerParamTable(), in_use, "keeping");
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("quality_level = nan"), std::string::npos) << errors[0];
+  EXPECT_NE(errors[0].find("; keeping 0.02"), std::string::npos) << errors[0];
+  EXPECT_EQ(p.quality_level, 0.02);
+  EXPECT_EQ(p.max_features, 150);
+}
+
 TEST(ParamTable, ValidateNestedAndNodeParams) {
   PlaneNodeParams p;
   p.pipeline.map.max_planes = 0;

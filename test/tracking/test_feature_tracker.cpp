@@ -828,15 +828,22 @@ size_t runToASpreadSearch(FeatureTracker& tracker, const std::vector<cv::Matx33d
   return hs.size();
 }
 
+// A tracker of 150 features spreading its searches over 5 images, run on views moving
+// sideways (points leave at the side) until a spread search starts, on hs[k].
+struct SpreadSearchStarted {
+  TrackerParams params = spreadOverFive();
+  FeatureTracker tracker{params};
+  std::vector<cv::Matx33d> hs = translations(40, kCentred, {4.0, 0.0});
+  size_t k = runToASpreadSearch(tracker, hs);
+};
+
 }  // namespace
 
 // A spread search in progress finishes under the values it started with; the new ones
 // apply from the image after it.
 TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
-  const TrackerParams params = spreadOverFive();
-  FeatureTracker tracker(params);
-  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
-  size_t k = runToASpreadSearch(tracker, hs);
+  SpreadSearchStarted started;
+  auto& [params, tracker, hs, k] = started;
   ASSERT_LT(k, hs.size());
   TrackerParams changed = params;
   changed.quality_level = 0.05;
@@ -854,10 +861,8 @@ TEST(FeatureTracker, NewParamsWaitForASpreadSearchToEnd) {
 
 // A reset takes the parameters waiting for a spread search at once (there is none left).
 TEST(FeatureTracker, ResetTakesWaitingParams) {
-  const TrackerParams params = spreadOverFive();
-  FeatureTracker tracker(params);
-  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
-  size_t k = runToASpreadSearch(tracker, hs);
+  SpreadSearchStarted started;
+  auto& [params, tracker, hs, k] = started;
   ASSERT_LT(k, hs.size());
   TrackerParams changed = params;
   changed.max_features = 20;
@@ -911,10 +916,8 @@ TEST(FeatureTracker, SetParamsRefusesValuesOutOfRange) {
 
 // A lower max_features set while a spread search runs: the search adds no more than it.
 TEST(FeatureTracker, ASpreadSearchAddsNoMoreThanAWaitingLowerMax) {
-  const TrackerParams params = spreadOverFive();
-  FeatureTracker tracker(params);
-  const auto hs = translations(40, kCentred, {4.0, 0.0});  // points leave at the side
-  size_t k = runToASpreadSearch(tracker, hs);
+  SpreadSearchStarted started;
+  auto& [params, tracker, hs, k] = started;
   ASSERT_LT(k, hs.size());
   const size_t live = tracker.current().size();
   ASSERT_LT(live, 150u);

@@ -135,7 +135,8 @@ class PlanePipeline {
   void reset();
 
  private:
-  bool trackerStartedOver(const TrackFrame& frame) const;
+  // newest: the frame's largest id (0 when it has none).
+  bool trackerStartedOver(const TrackFrame& frame, std::uint64_t newest) const;
   void assignImageIds(std::vector<ImagePlane>& planes);
   // motion_plane_images: replaces the observation of each image plane with too few
   // landmarks by its tracks on the fused plane from motion, once that is known well.

@@ -92,19 +92,20 @@ std::string rangeError(const ParamSpec<P>& spec, const ParamField& value) {
   return why.str();
 }
 
-// Puts the default back into every out-of-range field of `params` and returns one
-// message per field ("NAME = VALUE is out of range [MIN, MAX]; using the default D").
-// Defaults are those of a default-constructed P.
+// Puts `fallback`'s value back into every out-of-range field of `params` and returns one
+// message per field ("NAME = VALUE is out of range [MIN, MAX]; <using> D"): at start the
+// defaults ("using the default"), while running the values in use ("keeping": a bad input
+// is dropped, the state kept).
 template <class P>
-std::vector<std::string> validate(P& params, const ParamTable<P>& table) {
+std::vector<std::string> validate(P& params, const ParamTable<P>& table, P fallback_values,
+                                  const std::string& using_text) {
   std::vector<std::string> errors;
-  P defaults;
   for (const ParamSpec<P>& spec : table) {
     const ParamField value = spec.field(params);
     std::string error = rangeError(spec, value);
     if (error.empty()) continue;
-    const ParamField fallback = spec.field(defaults);
-    error += "; using the default " + toString(fallback);
+    const ParamField fallback = spec.field(fallback_values);
+    error += "; " + using_text + " " + toString(fallback);
     std::visit(
         [&](auto* target) {
           using T = std::remove_pointer_t<decltype(target)>;
@@ -114,6 +115,12 @@ std::vector<std::string> validate(P& params, const ParamTable<P>& table) {
     errors.push_back(std::move(error));
   }
   return errors;
+}
+
+// The same with the defaults of a default-constructed P.
+template <class P>
+std::vector<std::string> validate(P& params, const ParamTable<P>& table) {
+  return validate(params, table, P(), "using the default");
 }
 
 template <class P>
