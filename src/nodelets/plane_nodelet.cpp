@@ -15,11 +15,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <cmath>
 #include <deque>
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <map>
 #include <memory>
@@ -29,6 +26,7 @@
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
+#include "map_file.h"
 #include "mono_plane_detection/PlanesConfig.h"
 #include "mono_plane_detection/SaveMap.h"
 #include "mono_plane_detection/mapping/plane_pipeline.h"
@@ -335,30 +333,13 @@ class PlaneNodelet : public nodelet::Nodelet {
         std::lock_guard<std::mutex> lock(mutex_);
         planes = last_planes_;
       }
-      if (req.path.empty()) {
-        res.message = "no path given";
-      } else if (!planes) {
+      if (!planes && !req.path.empty()) {
         res.message = "no map yet";
-      } else {
-        // A relative path is relative to the manager's working directory (ROS_HOME,
-        // ~/.ros, under roslaunch), not the caller's: the answer names the whole path.
-        std::error_code error;
-        const std::filesystem::path path = std::filesystem::absolute(req.path, error);
-        const std::filesystem::path target = error ? std::filesystem::path(req.path) : path;
-        std::ofstream out(target);
-        const int open_errno = out ? 0 : errno;  // (meaningful right after the open only)
-        out << planesYaml(*planes);
-        out.close();
-        if (!out) {
-          res.message = "cannot write " + target.string() + " (" +
-                        (open_errno ? std::error_code(open_errno, std::generic_category()).message()
-                                    : std::string("write failed")) +
-                        ")";
-        } else {
-          res.success = true;
-          for (const auto& p : planes->planes) res.planes += p.metric;
-          res.message = "wrote " + std::to_string(res.planes) + " planes to " + target.string();
-        }
+      } else {  // (an empty path is refused there, map or not)
+        const MapFileResult written = writeMapFile(planes ? *planes : PlaneArray(), req.path);
+        res.success = written.success;
+        res.planes = written.planes;
+        res.message = written.message;
       }
       if (res.success)
         NODELET_INFO("save_map: %s", res.message.c_str());

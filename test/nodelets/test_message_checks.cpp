@@ -4,13 +4,19 @@
 // jumps.
 #include <cv_bridge/cv_bridge.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <opencv2/calib3d.hpp>
+#include <sstream>
 
 #include "../../src/nodelets/camera_info_check.h"
+#include "../../src/nodelets/map_file.h"
 #include "../../src/nodelets/nodelet_diagnostics.h"
 #include "../../src/nodelets/plane_messages.h"
 #include "../../src/nodelets/recent_events.h"
@@ -908,6 +914,50 @@ TEST(PlaneMessages, ConfirmedPlanesAreFlagged) {
   for (const auto& m : markers->markers)
     if (m.ns == "labels") tentative_labels += m.text.find("tentative") != std::string::npos;
   EXPECT_EQ(tentative_labels, 1);
+}
+
+// ~save_map's file (writeMapFile): the YAML of the planes, metric planes counted; a
+// relative path answered with the whole path (the manager's working directory is not
+// the caller's); nothing written names why.
+TEST(MapFile, WritesThePlanesAndSaysWhere) {
+  PlaneArray planes;
+  planes.header.frame_id = "plane_map";
+  planes.planes.resize(3);
+  planes.planes[0].metric = planes.planes[1].metric = true;  // the third: image space only
+  planes.planes[0].label = PlaneEstimate::LABEL_FLOOR;
+  char dir_template[] = "/tmp/mpd_map_file_XXXXXX";
+  ASSERT_NE(mkdtemp(dir_template), nullptr);
+  const std::string dir = dir_template;
+  const std::string path = dir + "/map.yaml";
+  const MapFileResult written = writeMapFile(planes, path);
+  ASSERT_TRUE(written.success) << written.message;
+  EXPECT_EQ(written.planes, 2);
+  EXPECT_EQ(written.message, "wrote 2 planes to " + path);
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), planesYaml(planes));
+
+  char* const cwd = getcwd(nullptr, 0);
+  ASSERT_NE(cwd, nullptr);
+  ASSERT_EQ(chdir(dir.c_str()), 0);
+  const MapFileResult relative = writeMapFile(planes, "relative.yaml");
+  ASSERT_EQ(chdir(cwd), 0);
+  std::free(cwd);
+  EXPECT_TRUE(relative.success) << relative.message;
+  EXPECT_EQ(relative.message, "wrote 2 planes to " + dir + "/relative.yaml");
+  EXPECT_TRUE(std::ifstream(dir + "/relative.yaml").good());
+
+  const MapFileResult nowhere = writeMapFile(planes, dir + "/no_such_dir/map.yaml");
+  EXPECT_FALSE(nowhere.success);
+  EXPECT_EQ(nowhere.message,
+            "cannot write " + dir + "/no_such_dir/map.yaml (No such file or directory)");
+  const MapFileResult no_path = writeMapFile(planes, "");
+  EXPECT_FALSE(no_path.success);
+  EXPECT_EQ(no_path.message, "no path given");
+  std::remove((dir + "/relative.yaml").c_str());
+  std::remove(path.c_str());
+  rmdir(dir.c_str());
 }
 
 // rviz lights a triangle by the normal of its winding (the light comes from the viewer): a
