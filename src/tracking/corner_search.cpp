@@ -189,37 +189,47 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
   const int rows = per_cell ? std::max(1, static_cast<int>(std::ceil(image.rows / cell_px))) : 1;
   std::vector<float>& bar = buffers.bar;
   bar.assign(static_cast<size_t>(cols * rows), 0.f);
-  std::vector<int>& column_cell = buffers.column_cell;
-  column_cell.resize(image.cols);
-  for (int x = 0; x < image.cols; ++x)
-    column_cell[x] = per_cell ? std::min(cols - 1, static_cast<int>(x / cell_px)) : 0;
-  auto rowCell = [&](int y) {
-    return per_cell ? std::min(rows - 1, static_cast<int>(y / cell_px)) * cols : 0;
+  // Cell c holds the columns x with min(cols - 1, x / cell_px) == c (rows alike): whole
+  // cells are rectangles, for OpenCV's vectorised minMaxLoc and threshold.
+  auto edges = [&](int length, int cells, std::vector<int>& edge) {
+    edge.assign(static_cast<size_t>(cells) + 1, length);
+    edge[0] = 0;
+    for (int x = 0, c = 0; x < length && per_cell; ++x)
+      for (const int at = std::min(cells - 1, static_cast<int>(x / cell_px)); c < at;)
+        edge[++c] = x;
+  };
+  edges(image.cols, cols, buffers.column_edge);
+  edges(image.rows, rows, buffers.row_edge);
+  auto cellOf = [&](int r, int c) {
+    const std::vector<int>&x = buffers.column_edge, &y = buffers.row_edge;
+    return cv::Rect(x[c], y[r], x[c + 1] - x[c], y[r + 1] - y[r]);
   };
   if (per_cell) {
-    for (int y = 0; y < image.rows; ++y) {
-      const float* e = eig.ptr<float>(y);
-      float* b = bar.data() + rowCell(y);
-      for (int x = 0; x < image.cols; ++x) b[column_cell[x]] = std::max(b[column_cell[x]], e[x]);
-    }
     relaxed_cells.resize(bar.size());
-    for (size_t c = 0; c < bar.size(); ++c) {
-      const float own =
-          std::max(static_cast<float>(noise_floor), static_cast<float>(quality_level) * bar[c]);
-      bar[c] = std::min(global_bar, own);
-      relaxed_cells[c] = bar[c] < global_bar;
-    }
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const size_t k = static_cast<size_t>(r * cols + c);
+        double strongest_here = 0;
+        const cv::Rect cell = cellOf(r, c);
+        if (cell.area() > 0) cv::minMaxLoc(eig(cell), nullptr, &strongest_here);
+        const float own = std::max(
+            static_cast<float>(noise_floor),
+            static_cast<float>(quality_level) * std::max(0.f, static_cast<float>(strongest_here)));
+        bar[k] = std::min(global_bar, own);
+        relaxed_cells[k] = bar[k] < global_bar;
+      }
   } else {
     bar[0] = global_bar;
   }
   // As goodFeaturesToTrack: responses at or under the bar are 0, then the local maxima
   // of a 3 x 3 dilation, strongest first, each at least min_distance from those before.
-  for (int y = 0; y < image.rows; ++y) {
-    float* e = eig.ptr<float>(y);
-    const float* b = bar.data() + rowCell(y);
-    for (int x = 0; x < image.cols; ++x)
-      if (e[x] <= b[column_cell[x]]) e[x] = 0.f;
-  }
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const cv::Rect cell = cellOf(r, c);
+      if (cell.area() == 0) continue;
+      cv::Mat part = eig(cell);
+      cv::threshold(part, part, bar[static_cast<size_t>(r * cols + c)], 0, cv::THRESH_TOZERO);
+    }
   cv::dilate(eig, buffers.dilated, cv::Mat());
   auto& candidates = buffers.candidates;
   candidates.clear();

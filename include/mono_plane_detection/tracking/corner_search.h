@@ -71,7 +71,7 @@ struct RelaxedCells {
 struct ShiTomasiBuffers {
   cv::Mat eig, dilated;
   std::vector<float> bar;
-  std::vector<int> column_cell;
+  std::vector<int> column_edge, row_edge;  // where each cell begins, and the image's end
   std::vector<std::pair<float, int>> candidates;
   std::vector<std::vector<cv::Point2f>> grid;
 };
