@@ -9,10 +9,14 @@
 
 namespace mono_plane_detection {
 
-MapFileResult writeMapFile(const PlaneArray& planes, const std::string& path) {
+MapFileResult writeMapFile(const PlaneArray* planes, const std::string& path) {
   MapFileResult result;
   if (path.empty()) {
     result.message = "no path given";
+    return result;
+  }
+  if (planes == nullptr) {
+    result.message = "no map yet";
     return result;
   }
   std::error_code error;
@@ -20,7 +24,7 @@ MapFileResult writeMapFile(const PlaneArray& planes, const std::string& path) {
   const std::filesystem::path target = error ? std::filesystem::path(path) : absolute;
   std::ofstream out(target);
   const int open_errno = out ? 0 : errno;  // (meaningful right after the open only)
-  out << planesYaml(planes);
+  out << planesYaml(*planes);
   out.close();
   if (!out) {
     result.message = "cannot write " + target.string() + " (" +
@@ -30,7 +34,7 @@ MapFileResult writeMapFile(const PlaneArray& planes, const std::string& path) {
     return result;
   }
   result.success = true;
-  for (const auto& p : planes.planes) result.planes += p.metric;
+  for (const auto& p : planes->planes) result.planes += p.metric;
   result.message = "wrote " + std::to_string(result.planes) + " planes to " + target.string();
   return result;
 }

@@ -13,9 +13,10 @@ struct MapFileResult {
   std::string message;  // "wrote N planes to PATH", or why nothing was written
 };
 
-// Writes `planes` as YAML to `path`. A relative path is relative to this process's
-// working directory (the manager's: ROS_HOME, ~/.ros, under roslaunch; not the caller's),
-// so the message names the whole path.
-MapFileResult writeMapFile(const PlaneArray& planes, const std::string& path);
+// Writes `planes` (null: no map yet) as YAML to `path`; refuses an empty path first. A
+// relative path is relative to this process's working directory (the manager's:
+// ROS_HOME, ~/.ros, under roslaunch; not the caller's), so the message names the whole
+// path.
+MapFileResult writeMapFile(const PlaneArray* planes, const std::string& path);
 
 }  // namespace mono_plane_detection

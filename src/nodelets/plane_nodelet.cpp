@@ -333,14 +333,10 @@ class PlaneNodelet : public nodelet::Nodelet {
         std::lock_guard<std::mutex> lock(mutex_);
         planes = last_planes_;
       }
-      if (!planes && !req.path.empty()) {
-        res.message = "no map yet";
-      } else {  // (an empty path is refused there, map or not)
-        const MapFileResult written = writeMapFile(planes ? *planes : PlaneArray(), req.path);
-        res.success = written.success;
-        res.planes = written.planes;
-        res.message = written.message;
-      }
+      const MapFileResult written = writeMapFile(planes.get(), req.path);
+      res.success = written.success;
+      res.planes = written.planes;
+      res.message = written.message;
       if (res.success)
         NODELET_INFO("save_map: %s", res.message.c_str());
       else

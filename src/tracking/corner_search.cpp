@@ -221,8 +221,9 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
   } else {
     bar[0] = global_bar;
   }
-  // As goodFeaturesToTrack: responses at or under the bar are 0, then the local maxima
-  // of a 3 x 3 dilation, strongest first, each at least min_distance from those before.
+  // As goodFeaturesToTrack: responses at or under the bar are 0 (a NaN too, which a
+  // response of an 8-bit image never holds), then the local maxima of a 3 x 3 dilation,
+  // strongest first, each at least min_distance from those before.
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
       const cv::Rect cell = cellOf(r, c);

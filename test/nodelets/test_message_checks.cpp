@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -916,20 +917,46 @@ TEST(PlaneMessages, ConfirmedPlanesAreFlagged) {
   EXPECT_EQ(tentative_labels, 1);
 }
 
+namespace {
+
+// A fresh folder under gtest's temporary directory; removed with what is in it, and the
+// working directory given back, however the test ends.
+struct ScratchDir {
+  std::string path, cwd;
+  ScratchDir() {
+    std::string pattern = testing::TempDir();
+    if (pattern.empty() || pattern.back() != '/') pattern += '/';
+    pattern += "mpd_map_file_XXXXXX";
+    if (mkdtemp(pattern.data()) != nullptr) path = pattern;
+    if (char* const here = getcwd(nullptr, 0)) {
+      cwd = here;
+      std::free(here);
+    }
+  }
+  ~ScratchDir() {
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) std::perror("chdir back");
+    std::error_code error;
+    if (!path.empty()) std::filesystem::remove_all(path, error);
+  }
+};
+
+}  // namespace
+
 // ~save_map's file (writeMapFile): the YAML of the planes, metric planes counted; a
 // relative path answered with the whole path (the manager's working directory is not
-// the caller's); nothing written names why.
+// the caller's); nothing written (no folder, a full disk, no path, no map) names why.
 TEST(MapFile, WritesThePlanesAndSaysWhere) {
   PlaneArray planes;
   planes.header.frame_id = "plane_map";
   planes.planes.resize(3);
   planes.planes[0].metric = planes.planes[1].metric = true;  // the third: image space only
   planes.planes[0].label = PlaneEstimate::LABEL_FLOOR;
-  char dir_template[] = "/tmp/mpd_map_file_XXXXXX";
-  ASSERT_NE(mkdtemp(dir_template), nullptr);
-  const std::string dir = dir_template;
+  const ScratchDir scratch;
+  ASSERT_FALSE(scratch.path.empty());
+  ASSERT_FALSE(scratch.cwd.empty());
+  const std::string& dir = scratch.path;
   const std::string path = dir + "/map.yaml";
-  const MapFileResult written = writeMapFile(planes, path);
+  const MapFileResult written = writeMapFile(&planes, path);
   ASSERT_TRUE(written.success) << written.message;
   EXPECT_EQ(written.planes, 2);
   EXPECT_EQ(written.message, "wrote 2 planes to " + path);
@@ -938,26 +965,33 @@ TEST(MapFile, WritesThePlanesAndSaysWhere) {
   text << in.rdbuf();
   EXPECT_EQ(text.str(), planesYaml(planes));
 
-  char* const cwd = getcwd(nullptr, 0);
-  ASSERT_NE(cwd, nullptr);
   ASSERT_EQ(chdir(dir.c_str()), 0);
-  const MapFileResult relative = writeMapFile(planes, "relative.yaml");
-  ASSERT_EQ(chdir(cwd), 0);
-  std::free(cwd);
+  const MapFileResult relative = writeMapFile(&planes, "relative.yaml");
+  ASSERT_EQ(chdir(scratch.cwd.c_str()), 0);
   EXPECT_TRUE(relative.success) << relative.message;
   EXPECT_EQ(relative.message, "wrote 2 planes to " + dir + "/relative.yaml");
   EXPECT_TRUE(std::ifstream(dir + "/relative.yaml").good());
 
-  const MapFileResult nowhere = writeMapFile(planes, dir + "/no_such_dir/map.yaml");
+  const MapFileResult nowhere = writeMapFile(&planes, dir + "/no_such_dir/map.yaml");
   EXPECT_FALSE(nowhere.success);
   EXPECT_EQ(nowhere.message,
             "cannot write " + dir + "/no_such_dir/map.yaml (No such file or directory)");
-  const MapFileResult no_path = writeMapFile(planes, "");
-  EXPECT_FALSE(no_path.success);
-  EXPECT_EQ(no_path.message, "no path given");
-  std::remove((dir + "/relative.yaml").c_str());
-  std::remove(path.c_str());
-  rmdir(dir.c_str());
+  // Opened, but the writing fails (a full disk).
+  if (std::ifstream("/dev/full").good()) {
+    const MapFileResult full = writeMapFile(&planes, "/dev/full");
+    EXPECT_FALSE(full.success);
+    EXPECT_EQ(full.message, "cannot write /dev/full (write failed)");
+  }
+  // An empty path is refused first, map or not.
+  for (const PlaneArray* map : std::initializer_list<const PlaneArray*>{&planes, nullptr}) {
+    const MapFileResult no_path = writeMapFile(map, "");
+    EXPECT_FALSE(no_path.success);
+    EXPECT_EQ(no_path.message, "no path given");
+  }
+  const MapFileResult no_map = writeMapFile(nullptr, dir + "/unwritten.yaml");
+  EXPECT_FALSE(no_map.success);
+  EXPECT_EQ(no_map.message, "no map yet");
+  EXPECT_FALSE(std::ifstream(dir + "/unwritten.yaml").good());
 }
 
 // rviz lights a triangle by the normal of its winding (the light comes from the viewer): a
