@@ -200,9 +200,11 @@ void shiTomasiCandidates(const cv::Mat& image, const cv::Mat& mask, double quali
   };
   edges(image.cols, cols, buffers.column_edge);
   edges(image.rows, rows, buffers.row_edge);
+  const std::vector<int>& column_edge = buffers.column_edge;
+  const std::vector<int>& row_edge = buffers.row_edge;
   auto cellOf = [&](int r, int c) {
-    const std::vector<int>&x = buffers.column_edge, &y = buffers.row_edge;
-    return cv::Rect(x[c], y[r], x[c + 1] - x[c], y[r + 1] - y[r]);
+    return cv::Rect(column_edge[c], row_edge[r], column_edge[c + 1] - column_edge[c],
+                    row_edge[r + 1] - row_edge[r]);
   };
   if (per_cell) {
     relaxed_cells.resize(bar.size());
