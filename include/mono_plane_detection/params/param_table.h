@@ -95,7 +95,8 @@ std::string rangeError(const ParamSpec<P>& spec, const ParamField& value) {
 // Puts `fallback`'s value back into every out-of-range field of `params` and returns one
 // message per field ("NAME = VALUE is out of range [MIN, MAX]; <using> D"): at start the
 // defaults ("using the default"), while running the values in use ("keeping": a bad input
-// is dropped, the state kept).
+// is dropped, the state kept). (fallback_values by value: a spec's field() reaches a
+// field through a mutable P.)
 template <class P>
 std::vector<std::string> validate(P& params, const ParamTable<P>& table, P fallback_values,
                                   const std::string& using_text) {
