@@ -17,12 +17,10 @@
 #include <atomic>
 #include <cmath>
 #include <deque>
-#include <iomanip>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
-#include <sstream>
 
 #include "callback_guard.h"
 #include "camera_info_check.h"
@@ -35,6 +33,7 @@
 #include "mono_plane_detection/viz/draw_planes.h"
 #include "nodelet_diagnostics.h"
 #include "plane_messages.h"
+#include "plane_status.h"
 #include "recent_events.h"
 #include "reconfigure_bridge.h"
 #include "ros_params.h"
@@ -56,35 +55,6 @@ geometry_msgs::TransformStamped toTransform(const Pose& parent_from_child, const
 
 std::string sizeText(const cv::Size& size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
-
-std::string secondsText(double s) {
-  std::ostringstream text;
-  text << std::setprecision(3) << s << " s";  // 0.25 s, 2.53 s, 10.5 s, 150 s
-  return text.str();
-}
-
-std::string degreesText(double deg) {
-  std::ostringstream text;
-  text << deg << " deg";
-  return text.str();
-}
-
-// Whether loose floors and walls are held level / upright by the map's up (mapping.md,
-// rule 7), and if not why: a user whose sheet lies on the floor sees it.
-std::string mapUpText(const PlanePipeline& pipeline, const std::string& metric_source) {
-  const MapParams& map = pipeline.map().params();
-  if (!map.upCanHold())
-    return map.up_sigma_deg <= 0       ? "off"
-           : map.structure_sigmas <= 0 ? "off (map/structure_sigmas 0)"
-                                       : "no effect: not below map/max_normal_sigma_deg";
-  if (!pipeline.verticalDecided()) return "not decided yet (at the first image placed in metres)";
-  if (pipeline.map().vertical()) return "held to it (" + degreesText(map.up_sigma_deg) + ")";
-  if (metric_source == "camera_height") return "not used: the map's up is the floor's own fit";
-  if (metric_source == "odometry")
-    return "not used: the camera at the map's start was not upright along the odometry's z";
-  return "not used: the camera at the map's start was not upright along the target's y (a "
-         "target on the floor or hung portrait?)";
 }
 
 }  // namespace
@@ -217,7 +187,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     node_ = node;
     params_ = node.pipeline;
     pipeline_->setPerImageParams(params_.planes, params_.frame_gap, params_.max_gap_s);
-    if (!first) ++reconfigures_;
+    if (!first) ++run_.reconfigures;
   }
 
   void connect() {
@@ -247,7 +217,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     if (error.empty()) error = cameraIntrinsicsError(camera.K, camera.D);
     std::lock_guard<std::mutex> lock(mutex_);
     if (!error.empty()) {
-      ++dropped_info_;
+      ++run_.dropped_info;
       // One throttle per reason: an unknown distortion model after a zero K is named too.
       if (problems_.note("camera_info " + reasonKind(error), "camera_info rejected: " + error,
                          10.0))
@@ -271,15 +241,15 @@ class PlaneNodelet : public nodelet::Nodelet {
       mapStartedOver();
       last_odom_.reset();
       last_planes_.reset();
-      tf_conflict_.clear();
+      run_.tf_conflict.clear();
       resolved_tf_mode_.clear();  // our earlier links stay ours (published_edges_)
       // Until the next tracks say otherwise (a paused robot's diagnostics kept the old map's).
-      status_ = "reset: the map starts over with the next tracks";
-      start_wait_s_ = start_target_unseen_s_ = 0;
-      metric_source_.clear();
-      tf_edge_.clear();
-      map_frame_shared_.clear();
-      ++resets_;
+      run_.status = "reset: the map starts over with the next tracks";
+      run_.start_wait_s = run_.start_target_unseen_s = 0;
+      run_.metric_source.clear();
+      run_.tf_edge.clear();
+      run_.map_frame_shared.clear();
+      ++run_.resets;
       NODELET_INFO("reset: the map and the camera pose start over");
       done = true;
     });
@@ -376,7 +346,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       const std::string error = odometryError(odom, last_odom_, max_odom_jump_m_);
       last_odom_ = odom;
       if (!error.empty()) {
-        ++refused_odom_;
+        ++run_.refused_odom;
         problems_.note("odometry refused", "odometry refused: " + error);
         if (logNow("odometry refused", 5.0))
           NODELET_WARN("odometry %s -> %s at %.3f refused (%s): visual pose used",
@@ -405,7 +375,7 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::optional<geometry_msgs::TransformStamped> transformFor(const Pose& ros_map_from_camera,
                                                               const std::optional<Pose>& odom,
                                                               const std_msgs::Header& header) {
-    if (!publish_tf_ || !tf_conflict_.empty()) return {};
+    if (!publish_tf_ || !run_.tf_conflict.empty()) return {};
     std::string parent, child;
     Pose parent_from_child;
     if (!odom_frame_.empty()) {
@@ -451,18 +421,18 @@ class PlaneNodelet : public nodelet::Nodelet {
       child = camera_frame_.empty() ? tfFrame(header.frame_id) + "_estimate" : camera_frame_;
       parent_from_child = ros_map_from_camera;
     }
-    tf_conflict_ = tf_view_->conflict(parent, child, published_edges_);
-    if (!tf_conflict_.empty() && child == map_frame_)
-      tf_conflict_ +=
+    run_.tf_conflict = tf_view_->conflict(parent, child, published_edges_);
+    if (!run_.tf_conflict.empty() && child == map_frame_)
+      run_.tf_conflict +=
           " (a second pipeline with the same map_frame? give each camera its own, "
           "e.g. map_frame:=robot1/plane_map)";
-    if (!tf_conflict_.empty()) {
+    if (!run_.tf_conflict.empty()) {
       NODELET_ERROR("tf refused, nothing more is published on tf (until ~reset): %s",
-                    tf_conflict_.c_str());
+                    run_.tf_conflict.c_str());
       return {};
     }
-    tf_edge_ = parent + " -> " + child;
-    published_edges_.insert(tf_edge_);
+    run_.tf_edge = parent + " -> " + child;
+    published_edges_.insert(run_.tf_edge);
     return toTransform(parent_from_child, header.stamp, parent, child);
   }
 
@@ -470,23 +440,16 @@ class PlaneNodelet : public nodelet::Nodelet {
   // robots or cameras launched with the default map_frame put two maps with unrelated
   // origins into one frame, and every status was OK (hostile try).
   void checkMapFrameShared() {
-    if (!tf_view_ || !publish_tf_ || tf_edge_.empty()) return;
+    if (!tf_view_ || !publish_tf_ || run_.tf_edge.empty()) return;
     const ros::WallTime now = ros::WallTime::now();
     if (now - shared_checked_ < ros::WallDuration(1.0)) return;
     shared_checked_ = now;
     std::string foreign;
     for (const std::string& edge : tf_view_->foreignLinks(map_frame_, published_edges_))
       foreign += (foreign.empty() ? "" : ", ") + edge;
-    if (!foreign.empty() && foreign != map_frame_shared_)
-      NODELET_WARN("%s", mapFrameSharedText(foreign).c_str());
-    map_frame_shared_ = foreign;
-  }
-
-  std::string mapFrameSharedText(const std::string& foreign) const {
-    return "map_frame '" + map_frame_ + "' also holds " + foreign +
-           " from another broadcaster on /tf: a second pipeline (another camera or robot) with "
-           "the same map_frame puts a map with an unrelated origin into this frame; give each "
-           "camera its own map_frame (e.g. map_frame:=robot1/plane_map)";
+    if (!foreign.empty() && foreign != run_.map_frame_shared)
+      NODELET_WARN("%s", mapFrameSharedText(map_frame_, foreign).c_str());
+    run_.map_frame_shared = foreign;
   }
 
   // Tracks wait (in order, without blocking a callback) until tf has the odometry at
@@ -504,7 +467,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     TrackFrame frame = toTrackFrame(*msg, error);
     if (!error.empty()) {
       std::lock_guard<std::mutex> lock(mutex_);
-      ++dropped_;
+      ++run_.dropped;
       if (problems_.note("tracks " + reasonKind(error), "tracks dropped: " + error))
         NODELET_ERROR("tracks dropped: %s", error.c_str());
       return;
@@ -621,7 +584,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       const bool other_frame = !msg.header.frame_id.empty() && !last_frame_id_.empty() &&
                                msg.header.frame_id != last_frame_id_;
       if (!last_tracks_size_.empty() && (other_frame || frame.size != last_tracks_size_)) {
-        ++camera_switches_;
+        ++run_.camera_switches;
         // A recent problem, not a state: the diagnostics are OK again a while after the
         // last switch (the total stays).
         const std::string why = "tracks changed camera ('" + last_frame_id_ + "' " +
@@ -637,9 +600,9 @@ class PlaneNodelet : public nodelet::Nodelet {
       // Corners of a target of another size than ours would fix a wrong scale (two
       // nodelets configured apart): refused, loudly, until they agree. Every message says
       // the tracker's target, so a tracker relaunched with the right one clears it at once.
-      target_mismatch_ = targetMismatch(msg, node_.pipeline.target);
-      if (!target_mismatch_.empty()) {
-        if (logNow("target mismatch", 10.0)) NODELET_ERROR("%s", target_mismatch_.c_str());
+      run_.target_mismatch = targetMismatch(msg, node_.pipeline.target);
+      if (!run_.target_mismatch.empty()) {
+        if (logNow("target mismatch", 10.0)) NODELET_ERROR("%s", run_.target_mismatch.c_str());
         frame.target_corner.assign(frame.target_corner.size(), false);
       }
       // A camera_info describes tracks of its image size only (binning and ROI applied):
@@ -648,13 +611,13 @@ class PlaneNodelet : public nodelet::Nodelet {
       std::string info_mismatch;
       const CameraIntrinsics* camera = calibration_.forImages(frame.size, info_mismatch);
       if (!info_mismatch.empty()) {
-        ++info_size_mismatch_;
+        ++run_.info_size_mismatch;
         if (logNow("info size", 10.0)) NODELET_ERROR("%s", info_mismatch.c_str());
       }
       // Another camera's camera_info? Used all the same, said (throttled) and counted.
       if (camera) {
         if (std::string other = infoFrameMismatch(*camera, msg.header.frame_id); !other.empty()) {
-          ++info_frame_mismatch_;
+          ++run_.info_frame_mismatch;
           if (logNow("info frame", 10.0))
             NODELET_WARN("%s (%s)", other.c_str(), info_sub_.getTopic().c_str());
         }
@@ -664,7 +627,7 @@ class PlaneNodelet : public nodelet::Nodelet {
       const bool target_in_tracks =
           std::find(frame.target_corner.begin(), frame.target_corner.end(), true) !=
           frame.target_corner.end();
-      if (target_in_tracks) target_missed_ = !camera;
+      if (target_in_tracks) run_.target_missed = !camera;
       if (camera) {
         pipeline_->setCamera(camera->K, camera->D);  // (checked on arrival; same: no change)
         undistortFisheye(frame, *camera);            // equidistant: pinhole pixels of the same K
@@ -680,16 +643,16 @@ class PlaneNodelet : public nodelet::Nodelet {
       const PipelineResult result = pipeline_->process(
           frame, odom ? std::optional<Pose>(targetFromRosMap(*odom)) : std::nullopt);
       const PoseEstimator* estimator = pipeline_->poseEstimator();
-      metric_source_ = estimator ? toString(estimator->metricSource()) : "";
+      run_.metric_source = estimator ? toString(estimator->metricSource()) : "";
       // The tf of the odometry source stopped: vision carries the pose (landmarks in the
       // odometry's frame, so no jump), said in diagnostics.
       // Any source: without odometry no map <-> odom tf is published for the image.
       // (Tracks of before a jump back of the clock say nothing of the odometry now.)
       if (!before_jump) {
-        odom_tf_problem_ = odom_tf_problem;
-        odom_rigid_ = odom_rigid;
-        odometry_stopped_ = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
-        odom_stale_link_ = odom_stale_link;
+        run_.odom_tf_problem = odom_tf_problem;
+        run_.odom_rigid = odom_rigid;
+        run_.odometry_stopped = !odom && !odom_frame_.empty() && odom_tf_problem.empty();
+        run_.odom_stale_link = odom_stale_link;
       }
       if (result.was_reset) {
         // Rare (a bag loop): every time while loops come at most once a second, on the
@@ -705,8 +668,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                   ? "; show the start-up target to the camera again"
                   : "");
           mapStartedOver();
-          ++resets_;
-          ++tracker_restarts_;
+          ++run_.resets;
+          ++run_.tracker_restarts;
         } else {
           if (logged_.note("backwards", "", 5.0, kRareEventBurst))
             NODELET_WARN(
@@ -714,8 +677,8 @@ class PlaneNodelet : public nodelet::Nodelet {
                 "loop?), the map starts over",
                 frame.stamp);
           mapStartedOver(true);
-          ++resets_;
-          ++backwards_resets_;
+          ++run_.resets;
+          ++run_.backwards_resets;
           stream_health_.wentBackwards();
         }
         // Under simulated time the listener cleared its buffer when it saw the clock go
@@ -756,21 +719,21 @@ class PlaneNodelet : public nodelet::Nodelet {
       } else {
         target_wait_.reset();
       }
-      ++frames_;
+      ++run_.frames;
       // Tracks missing by their stamps, as the pipeline's rhythm counts them: the tracker's
       // images it never got and tracks this nodelet's queue dropped (roscpp says neither).
-      missing_tracks_ += result.missing_images;
+      run_.missing_tracks += result.missing_images;
       stream_health_.received(result.missing_images);
-      status_ = result.status;
-      state_ = result.state;
-      start_wait_s_ = result.start_wait_s;
-      start_target_unseen_s_ = result.start_target_unseen_s;
-      observed_ = result.planes.size();
+      run_.status = result.status;
+      run_.state = result.state;
+      run_.start_wait_s = result.start_wait_s;
+      run_.start_target_unseen_s = result.start_target_unseen_s;
+      run_.observed = result.planes.size();
       std_msgs::Header map_header = msg.header;
       map_header.frame_id = map_frame_;
       image_planes = toImagePlanes(msg.header, result);
       planes = toMapPlanes(map_header, result, pipeline_->map());
-      planes->metric_source = image_planes->metric_source = metric_source_;
+      planes->metric_source = image_planes->metric_source = run_.metric_source;
       if (planes->metric) {
         const Pose ros_map_from_camera = rosMapFromTarget() * result.pose->map_from_camera;
         pose.reset(new geometry_msgs::PoseStamped);
@@ -814,131 +777,35 @@ class PlaneNodelet : public nodelet::Nodelet {
 
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     std::lock_guard<std::mutex> lock(mutex_);
-    using diagnostic_msgs::DiagnosticStatus;
-    const long exceptions = guard_.count();
-    // The present state first, then what happened lately; the summary is the most severe.
-    StatusProblems problems;
-    if (!tf_conflict_.empty())
-      problems.add(DiagnosticStatus::ERROR, "tf", "tf conflict: " + tf_conflict_);
-    else if (!map_frame_shared_.empty())
-      problems.add(DiagnosticStatus::WARN, "tf", mapFrameSharedText(map_frame_shared_));
-    // A metric source that cannot give metres is an error until it is set.
-    const std::string blocked = metricSourceProblem(node_);
-    if (!blocked.empty()) problems.add(DiagnosticStatus::ERROR, "configuration", blocked);
-    if (!target_mismatch_.empty())
-      problems.add(DiagnosticStatus::ERROR, "start-up target",
-                   "start-up target: " + target_mismatch_);
-    else if (target_missed_ && state_ == PipelineState::kWaitingForTarget)
-      problems.add(DiagnosticStatus::WARN, "start-up target",
-                   "the tracker found the start-up target before camera_info came, and it is "
-                   "not tracked any more: show it again and call the tracker's ~reset (it "
-                   "joins the target once), or publish camera_info with the first images");
-    // (Now: a camera_info or tracks of the right size clear it at once.)
-    const std::string info_mismatch = calibration_.mismatch(last_tracks_size_);
-    if (!info_mismatch.empty()) problems.add(DiagnosticStatus::ERROR, "camera_info", info_mismatch);
-    if (frames_ > 0 && !calibration_.latest() && cameraInfoOverdue())
-      problems.add(DiagnosticStatus::WARN, "camera_info",
-                   "tracks arrive but no usable camera_info");
-    if (state_ == PipelineState::kLost)
-      problems.add(
-          DiagnosticStatus::WARN, "tracking",
-          status_.rfind("lost", 0) == 0 ? "tracking " + status_ : "tracking lost: " + status_);
-    if (!odom_tf_problem_.empty())  // (a rigid odom_frame is a configuration error)
-      problems.add(odom_rigid_ ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, "odometry",
-                   "no odometry: " + odom_tf_problem_);
-    else if (pipeline_->odometryMonitor().disagrees())
-      problems.add(DiagnosticStatus::ERROR, "odometry", odometryMismatchText());
-    else if (odometry_stopped_ && !odom_stale_link_.empty() &&
-             odom_stale_link_.find(odom_frame_ + " -> ") == std::string::npos)
-      // Not the odometry's own link: another publisher between it and the camera.
-      problems.add(DiagnosticStatus::WARN, "odometry",
-                   "tf " + odom_stale_link_ + " (between the camera and odom_frame '" +
-                       odom_frame_ + "') is more than odom_wait_s (" + secondsText(odom_wait_s_) +
-                       ") behind the images: its publisher (robot_state_publisher with "
-                       "/joint_states for a joint) stopped or is late; " +
-                       (metric_source_ == "odometry"
-                            ? std::string("camera pose from vision only")
-                            : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
-    else if (odometry_stopped_)
-      problems.add(DiagnosticStatus::WARN, "odometry",
-                   "odometry (" + odom_frame_ + ") stopped, or more than odom_wait_s (" +
-                       secondsText(odom_wait_s_) + ") behind the images: " +
-                       (metric_source_ == "odometry"
-                            ? std::string("camera pose from vision only")
-                            : "no " + map_frame_ + " <-> " + odom_frame_ + " tf for these images"));
-    const double waited_s = target_wait_.seconds();  // (0 unless waiting for the start)
-    if (state_ == PipelineState::kWaitingForTarget && waited_s > target_timeout_s_)
-      problems.add(
-          DiagnosticStatus::WARN, "metric start",
-          (node_.pipeline.pose.metric_source == "target"
-               ? "start-up target not seen for " + std::to_string(static_cast<long>(waited_s)) +
-                     " s: show it to the camera, or start the metres without it "
-                     "(metric_source odometry with odom_frame, or camera_height "
-                     "with camera_height_m)"
-               : "no metric start (" + status_ + ") for " +
-                     std::to_string(static_cast<long>(waited_s)) + " s"));
-    // The target start that cannot finish (hostile try: OK for 550 images).
-    if (state_ == PipelineState::kInitialising && start_target_unseen_s_ > kStartTargetGoneS)
-      problems.add(DiagnosticStatus::WARN, "metric start",
-                   "the start-up target left the view " + secondsText(start_target_unseen_s_) +
-                       " ago, before the start finished (it needs the target in two views "
-                       "with parallax): show it to the camera again and move a few cm "
-                       "sideways; if its corners were lost, the tracker looks for it again "
-                       "only after its ~reset");
-    else if (state_ == PipelineState::kInitialising && start_wait_s_ > target_timeout_s_)
-      problems.add(DiagnosticStatus::WARN, "metric start",
-                   "the start has waited " + secondsText(start_wait_s_) +
-                       " for parallax with the target in view: move the camera a few cm "
-                       "sideways (or towards it) while it sees the target; turning on the "
-                       "spot gives no parallax");
-    // The stream lately (as the tracker's).
-    problems.addWarnings(stream_health_.problems(
+    PlaneStatusView view;
+    view.map_frame = map_frame_;
+    view.odom_frame = odom_frame_;
+    view.metric_source_param = node_.pipeline.pose.metric_source;
+    view.config_blocked = metricSourceProblem(node_);
+    view.refused_params = start_errors_;
+    for (const std::string& e : reconfigure_errors_)
+      view.refused_params.push_back("reconfigure: " + e);
+    view.odom_wait_s = odom_wait_s_;
+    view.target_timeout_s = target_timeout_s_;
+    view.publish_tf = publish_tf_;
+    view.info_mismatch = calibration_.mismatch(last_tracks_size_);
+    view.camera_info_overdue = run_.frames > 0 && !calibration_.latest() && cameraInfoOverdue();
+    view.camera_model = cameraModelName(calibration_, last_tracks_size_);
+    if (pipeline_->odometryMonitor().disagrees()) view.odometry_mismatch = odometryMismatchText();
+    view.target_waited_s = target_wait_.seconds();  // (0 unless waiting for the start)
+    view.exceptions = guard_.count();
+    if (view.exceptions > 0) view.last_exception = guard_.lastReason();
+    view.odom_waits_in_vain = odom_waits_in_vain_.load();
+    view.map_up = mapUpText(*pipeline_, run_.metric_source);
+    view.map_planes = pipeline_->map().planes().size();
+    if (pipeline_->poseEstimator()) view.landmarks = pipeline_->poseEstimator()->landmarks().size();
+    view.stream_problems = stream_health_.problems(
         "tracks",
         "images the tracker never got, or this nodelet's queue overflowed: the map is "
         "slower than the stream, e.g. under CPU load",
-        "the map starting over", "tracks"));
-    // Other refused values were replaced by their defaults: after the present problems.
-    if (blocked.empty() && (!start_errors_.empty() || !reconfigure_errors_.empty())) {
-      std::vector<std::string> all = start_errors_;
-      for (const std::string& e : reconfigure_errors_) all.push_back("reconfigure: " + e);
-      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(all));
-    }
-    if (exceptions > 0) problems.add(DiagnosticStatus::WARN, "exceptions", "exceptions caught");
-    problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");  // the totals stay below
-    problems.report(status, status_.empty() ? "no tracks yet" : status_);
-    // The state also when a problem is the summary.
-    status.add("state", status_.empty() ? "no tracks yet" : status_);
-    status.add("exceptions caught (total)", exceptions);
-    if (exceptions > 0) status.add("last exception", guard_.lastReason());
-    status.add("camera switches (total)", camera_switches_);
-    status.add("odometry refused (total)", refused_odom_);
-    if (!odom_frame_.empty())
-      status.add("odometry waited for in vain (total)", odom_waits_in_vain_.load());
-    status.add("images processed", frames_);
-    status.add("tracks messages dropped", dropped_);
-    status.add("tracks missing from the stream (total)", missing_tracks_);
-    status.add("camera_info messages rejected", dropped_info_);
-    // The calibration of the last tracks' size (before any: the last camera_info).
-    status.add("camera model", cameraModelName(calibration_, last_tracks_size_));
-    status.add("tf", !tf_conflict_.empty() ? "refused: " + tf_conflict_
-                     : !publish_tf_        ? std::string("off")
-                     : tf_edge_.empty()    ? std::string("nothing published yet")
-                                           : tf_edge_);
-    status.add("metric source", metric_source_.empty()
-                                    ? "none yet (" + node_.pipeline.pose.metric_source + ")"
-                                    : metric_source_);
-    status.add("map up (map/up_sigma_deg)", mapUpText(*pipeline_, metric_source_));
-    status.add("tracks with camera_info of another size (total)", info_size_mismatch_);
-    status.add("tracks with camera_info of another frame_id (total)", info_frame_mismatch_);
-    // Every start over of the map: ~reset calls and time going backwards (a bag loop).
-    status.add("resets (total)", resets_);
-    status.add("resets: time went backwards (total)", backwards_resets_);
-    status.add("resets: the tracker started over (total)", tracker_restarts_);
-    status.add("reconfigurations (total)", reconfigures_);
-    status.add("planes in this image", observed_);
-    status.add("planes in the map", pipeline_->map().planes().size());
-    if (pipeline_->poseEstimator())
-      status.add("landmarks", pipeline_->poseEstimator()->landmarks().size());
+        "the map starting over", "tracks");
+    view.recent_problems = problems_.recent(kRecentS);
+    reportPlaneStatus(run_, view, status);
   }
 
   CallbackGuard guard_;                          // first member: the last destroyed
@@ -950,8 +817,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::string map_frame_, odom_frame_, camera_frame_, transport_, tf_mode_;
   bool publish_tf_ = true, rectified_ = false;
   double target_timeout_s_ = 30;
-  double start_wait_s_ = 0, start_target_unseen_s_ = 0;  // PipelineResult's, last tracks
-  static constexpr double kStartTargetGoneS = 2.0;       // a target out of view longer: WARN
 
   ros::Publisher planes_pub_, image_planes_pub_, pose_pub_, markers_pub_, cloud_pub_;
   ros::Subscriber tracks_sub_, info_sub_, static_sub_;
@@ -983,12 +848,6 @@ class PlaneNodelet : public nodelet::Nodelet {
   std::mutex mutex_, connect_mutex_;  // mutex_ guards everything below and the pipeline
   std::deque<sensor_msgs::ImageConstPtr> images_;
   CalibrationHolder calibration_;       // the usable camera_infos
-  long info_size_mismatch_ = 0;         // tracks it was not used for (another image size)
-  long info_frame_mismatch_ = 0;        // tracks whose camera_info names another frame
-  long backwards_resets_ = 0;           // map resets because time went backwards
-  long tracker_restarts_ = 0;           // map resets because the tracker started over
-  std::string odom_tf_problem_;         // why tf links no odometry to the last tracks' camera
-  bool odom_rigid_ = false;             // ...because odom_frame is rigid with the camera
   ros::Time clock_seen_, jumped_from_;  // fromBeforeClockJump()
   RecentEvents logged_;                 // log throttles on wall time (logNow)
   std::set<int> markers_shown_;
@@ -996,14 +855,11 @@ class PlaneNodelet : public nodelet::Nodelet {
   // clears the old one's planes from rviz (hostile try: they stayed beside the new; a
   // DELETEALL at load would reach no rviz not yet connected). Start-overs publish their own.
   bool reset_markers_ = true;
-  PipelineState last_state_ = PipelineState::kNoCamera, state_ = PipelineState::kNoCamera;
-  std::string status_;
+  PipelineState last_state_ = PipelineState::kNoCamera;
+  PlaneRunState run_;            // the last tracks' state and the totals, for diagnose()
   std::string last_status_key_;  // the status last logged, without its "; ..." remark
-  long missing_tracks_ = 0;      // tracks missing from the stream, total
   StreamHealth stream_health_;   // tracks missing, time going back (last 10 s)
   ros::WallTime first_tracks_;   // wall time of the first tracks (camera_info's grace)
-  long frames_ = 0, dropped_ = 0, dropped_info_ = 0, refused_odom_ = 0, camera_switches_ = 0,
-       resets_ = 0, reconfigures_ = 0;
   double max_odom_jump_m_ = 1.0;
   double odom_wait_s_ = 0.25;
   std::atomic<long> odom_waits_in_vain_{0};  // tracks that waited odom_wait_s for nothing
@@ -1012,19 +868,8 @@ class PlaneNodelet : public nodelet::Nodelet {
   ros::Time last_odom_stamp_;
   std::string last_frame_id_;
   cv::Size last_tracks_size_;
-  size_t observed_ = 0;
   PlaneArrayConstPtr last_planes_;
-  std::string metric_source_;      // the source that started the map, "" before
-  bool odometry_stopped_ = false;  // odom_frame set but no odometry for the last image
-  std::string odom_stale_link_;    // then the link on tf that lacked its stamp, if found
-  // The last tracks with the start-up target's corners came without a camera (no
-  // camera_info): the map never saw the target (hostile try: camera_info 2.5 s late).
-  bool target_missed_ = false;
   std::string resolved_tf_mode_;           // above_odom | below_odom once decided
-  std::string tf_conflict_;                // why tf was refused; "" when fine
-  std::string target_mismatch_;            // the tracker's target is not ours (last flagged tracks)
-  std::string tf_edge_;                    // what is published
-  std::string map_frame_shared_;           // others' links into map_frame ("" when none)
   ros::WallTime shared_checked_;           // (checkMapFrameShared)
   std::set<std::string> published_edges_;  // links this nodelet has put on tf
   // Last: destroyed first, so no reconfigure callback outlives what it locks and changes.

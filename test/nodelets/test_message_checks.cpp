@@ -20,6 +20,7 @@
 #include "../../src/nodelets/map_file.h"
 #include "../../src/nodelets/nodelet_diagnostics.h"
 #include "../../src/nodelets/plane_messages.h"
+#include "../../src/nodelets/plane_status.h"
 #include "../../src/nodelets/recent_events.h"
 #include "../../src/nodelets/stretched_wait.h"
 #include "../../src/nodelets/tracker_front_end.h"
@@ -389,6 +390,230 @@ TEST(StatusProblems, EveryProblemHasItsKeyAndTheWorstIsTheSummary) {
   EXPECT_EQ(value(warned, "problems now"), "3");
   EXPECT_EQ(value(warned, "problem: time"), "WARN: went back 3 times");
   EXPECT_EQ(value(warned, "problem: last 10 s, camera_info rejected"), "WARN: K is zero");
+}
+
+namespace {
+std::string statusValue(const diagnostic_updater::DiagnosticStatusWrapper& s,
+                        const std::string& key) {
+  for (const auto& kv : s.values)
+    if (kv.key == key) return kv.value;
+  return "(none)";
+}
+
+diagnostic_updater::DiagnosticStatusWrapper planeStatus(const PlaneRunState& run,
+                                                        const PlaneStatusView& view) {
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  reportPlaneStatus(run, view, status);
+  return status;
+}
+
+PlaneStatusView planeView() {
+  PlaneStatusView view;
+  view.map_frame = "plane_map";
+  view.metric_source_param = "target";
+  view.camera_model = "raw (K, D)";
+  view.map_up = "held to it (0.2 deg)";
+  return view;
+}
+}  // namespace
+
+// The plane nodelet's diagnostics when all is well: OK with the pipeline's status, and
+// its totals under their names.
+TEST(PlaneStatus, AllWellIsTheStatusWithTheTotals) {
+  PlaneRunState run;
+  run.state = PipelineState::kTracking;
+  run.status = "tracking (target)";
+  run.metric_source = "target";
+  run.tf_edge = "plane_map -> camera_estimate";
+  run.frames = 120;
+  run.resets = 2;
+  run.backwards_resets = 1;
+  run.observed = 3;
+  PlaneStatusView view = planeView();
+  view.map_planes = 5;
+  view.landmarks = 80;
+  const auto status = planeStatus(run, view);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
+  EXPECT_EQ(status.message, "tracking (target)");
+  EXPECT_EQ(statusValue(status, "problems now"), "0");
+  EXPECT_EQ(statusValue(status, "state"), "tracking (target)");
+  EXPECT_EQ(statusValue(status, "images processed"), "120");
+  EXPECT_EQ(statusValue(status, "resets (total)"), "2");
+  EXPECT_EQ(statusValue(status, "resets: time went backwards (total)"), "1");
+  EXPECT_EQ(statusValue(status, "tf"), "plane_map -> camera_estimate");
+  EXPECT_EQ(statusValue(status, "metric source"), "target");
+  EXPECT_EQ(statusValue(status, "camera model"), "raw (K, D)");
+  EXPECT_EQ(statusValue(status, "map up (map/up_sigma_deg)"), "held to it (0.2 deg)");
+  EXPECT_EQ(statusValue(status, "planes in this image"), "3");
+  EXPECT_EQ(statusValue(status, "planes in the map"), "5");
+  EXPECT_EQ(statusValue(status, "landmarks"), "80");
+  // Only with odom_frame: the odometry waits.
+  EXPECT_EQ(statusValue(status, "odometry waited for in vain (total)"), "(none)");
+  // Before any tracks: said so, the configured source named, nothing published.
+  PlaneStatusView before = planeView();
+  before.publish_tf = true;
+  const auto fresh = planeStatus(PlaneRunState(), before);
+  EXPECT_EQ(fresh.level, diagnostic_msgs::DiagnosticStatus::OK);
+  EXPECT_EQ(fresh.message, "no tracks yet");
+  EXPECT_EQ(statusValue(fresh, "metric source"), "none yet (target)");
+  EXPECT_EQ(statusValue(fresh, "tf"), "nothing published yet");
+  EXPECT_EQ(statusValue(fresh, "landmarks"), "(none)");
+  before.publish_tf = false;
+  EXPECT_EQ(statusValue(planeStatus(PlaneRunState(), before), "tf"), "off");
+}
+
+// Each problem under its key with its level; the worst, first added, is the summary.
+TEST(PlaneStatus, EachProblemHasItsLevelAndTheWorstIsTheSummary) {
+  using diagnostic_msgs::DiagnosticStatus;
+  PlaneRunState run;
+  run.state = PipelineState::kLost;
+  run.status = "lost: 0.8 s without tracks";
+  run.map_frame_shared = "plane_map -> odom";
+  PlaneStatusView view = planeView();
+  view.camera_info_overdue = true;
+  auto status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(status.message, mapFrameSharedText("plane_map", "plane_map -> odom"));
+  EXPECT_EQ(statusValue(status, "problems now"), "3");
+  EXPECT_EQ(statusValue(status, "problem: tracking"), "WARN: tracking lost: 0.8 s without tracks");
+  EXPECT_EQ(statusValue(status, "problem: camera_info"),
+            "WARN: tracks arrive but no usable camera_info");
+  EXPECT_EQ(statusValue(status, "state"), "lost: 0.8 s without tracks");  // also then
+  // A tf conflict is an ERROR and hides the shared map frame (one key each).
+  run.tf_conflict = "camera_link already has the parent base_link";
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, "tf conflict: camera_link already has the parent base_link");
+  EXPECT_EQ(statusValue(status, "tf"), "refused: camera_link already has the parent base_link");
+  // A configuration that gives no metres is an ERROR; refused values are then not listed.
+  run = PlaneRunState();
+  view = planeView();
+  view.refused_params = {"planes/max_groups = -3 is below 1: 100 used"};
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::WARN);
+  EXPECT_NE(statusValue(status, "problem: configuration").find("max_groups"), std::string::npos);
+  view.config_blocked = "metric_source odometry needs odom_frame";
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
+  EXPECT_EQ(statusValue(status, "problem: configuration"),
+            "ERROR: metric_source odometry needs odom_frame");
+  // Exceptions, the stream and recent refusals: WARNs with their keys.
+  view = planeView();
+  view.exceptions = 2;
+  view.last_exception = "tracks: bad_alloc";
+  view.stream_problems = {{"tracks missing", "40 of 300 tracks missing"}};
+  view.recent_problems = {{"camera_info rejected", "camera_info rejected: K is zero"}};
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(statusValue(status, "problems now"), "3");
+  EXPECT_EQ(statusValue(status, "problem: exceptions"), "WARN: exceptions caught");
+  EXPECT_EQ(statusValue(status, "last exception"), "tracks: bad_alloc");
+  EXPECT_EQ(statusValue(status, "problem: tracks missing"), "WARN: 40 of 300 tracks missing");
+  EXPECT_EQ(statusValue(status, "problem: last 10 s, camera_info rejected"),
+            "WARN: camera_info rejected: K is zero");
+}
+
+// The odometry's problems: one at a time, the most telling; what the map does without it
+// depends on the metric source.
+TEST(PlaneStatus, OdometryProblemsSayWhatToLookAt) {
+  using diagnostic_msgs::DiagnosticStatus;
+  PlaneRunState run;
+  run.state = PipelineState::kTracking;
+  run.status = "tracking (odometry)";
+  run.metric_source = "odometry";
+  PlaneStatusView view = planeView();
+  view.odom_frame = "odom";
+  view.odom_waits_in_vain = 4;
+  run.odometry_stopped = true;
+  auto status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(status.message,
+            "odometry (odom) stopped, or more than odom_wait_s (0.25 s) behind the images: "
+            "camera pose from vision only");
+  EXPECT_EQ(statusValue(status, "odometry waited for in vain (total)"), "4");
+  // Another publisher's link lags: it is named; with the target as the source no map <->
+  // odom link is published for these images.
+  run.metric_source = "target";
+  run.odom_stale_link = "base_link -> camera_link";
+  status = planeStatus(run, view);
+  EXPECT_NE(status.message.find("tf base_link -> camera_link (between the camera and "
+                                "odom_frame 'odom')"),
+            std::string::npos);
+  EXPECT_NE(status.message.find("no plane_map <-> odom tf for these images"), std::string::npos);
+  // The odometry's own link lags: the odometry stopped.
+  run.odom_stale_link = "odom -> base_link";
+  EXPECT_EQ(planeStatus(run, view).message.rfind("odometry (odom) stopped", 0), 0u);
+  // Disagreeing with the images is an ERROR, and so is a rigid odom_frame.
+  view.odometry_mismatch = "the odometry does not move the camera as its images show";
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, view.odometry_mismatch);
+  run.odom_tf_problem = "odom_frame 'base_link' is rigid with the camera";
+  run.odom_rigid = true;
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, "no odometry: odom_frame 'base_link' is rigid with the camera");
+  run.odom_rigid = false;  // not linked at all: a WARN
+  EXPECT_EQ(planeStatus(run, view).level, DiagnosticStatus::WARN);
+}
+
+// The metric start that does not come: after target_timeout_s, with what to do; the
+// target start that cannot finish: at once when the target left, after the timeout when
+// the camera does not move.
+TEST(PlaneStatus, AMetricStartThatDoesNotComeSaysWhatToDo) {
+  PlaneRunState run;
+  run.state = PipelineState::kWaitingForTarget;
+  run.status = "waiting for the start-up target";
+  PlaneStatusView view = planeView();
+  view.target_waited_s = 29;
+  EXPECT_EQ(planeStatus(run, view).level, diagnostic_msgs::DiagnosticStatus::OK);
+  view.target_waited_s = 31;
+  auto status = planeStatus(run, view);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(status.message.rfind("start-up target not seen for 31 s: show it to the camera", 0),
+            0u);
+  view.metric_source_param = "camera_height";
+  run.status = "waiting for the floor";
+  EXPECT_EQ(planeStatus(run, view).message, "no metric start (waiting for the floor) for 31 s");
+  // The tracker saw the target before camera_info: show it again.
+  run.target_missed = true;
+  EXPECT_NE(statusValue(planeStatus(run, view), "problem: start-up target")
+                .find("before camera_info came"),
+            std::string::npos);
+  run.target_mismatch = "the tracker's target is 0.297 x 0.21 m, ours 0.2 x 0.2 m";
+  status = planeStatus(run, view);
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(status.message, "start-up target: " + run.target_mismatch);
+  // Initialising: the target gone for over 2 s, or no parallax for target_timeout_s.
+  run = PlaneRunState();
+  run.state = PipelineState::kInitialising;
+  run.status = "initialising";
+  view = planeView();
+  run.start_target_unseen_s = 1.5;
+  run.start_wait_s = 10;
+  EXPECT_EQ(planeStatus(run, view).level, diagnostic_msgs::DiagnosticStatus::OK);
+  run.start_target_unseen_s = 2.5;
+  EXPECT_EQ(planeStatus(run, view).message.rfind("the start-up target left the view 2.5 s ago", 0),
+            0u);
+  run.start_target_unseen_s = 0;
+  run.start_wait_s = 31;
+  EXPECT_EQ(planeStatus(run, view).message.rfind("the start has waited 31 s for parallax", 0), 0u);
+}
+
+// The map's up: whether loose planes are held to it, and why not.
+TEST(PlaneStatus, MapUpSaysWhetherItHoldsAndWhyNot) {
+  PipelineParams params;
+  EXPECT_EQ(mapUpText(PlanePipeline(params), "target"),
+            "not decided yet (at the first image placed in metres)");
+  params.map.up_sigma_deg = 0;
+  EXPECT_EQ(mapUpText(PlanePipeline(params), "target"), "off");
+  params.map.up_sigma_deg = 0.2;
+  params.map.structure_sigmas = 0;
+  EXPECT_EQ(mapUpText(PlanePipeline(params), "target"), "off (map/structure_sigmas 0)");
+  params.map.structure_sigmas = 3;
+  params.map.up_sigma_deg = params.map.max_normal_sigma_deg + 0.5;
+  EXPECT_EQ(mapUpText(PlanePipeline(params), "target"),
+            "no effect: not below map/max_normal_sigma_deg");
 }
 
 // The input rate: a moment's wait for the first input after the start or a (lazy)
