@@ -752,3 +752,52 @@ TEST(PlaneMap, ALooseStripIsNotHeld) {
   EXPECT_GT(floor->normal_sigma_deg, map.params().max_normal_sigma_deg);
   EXPECT_LT(normalAngleDeg(floor->normal, floor->own_normal), 1e-12);
 }
+
+// Issue 18 (the furnished room painted with TUM photographs, wheeled, noise seed 0): a
+// shelf front came out 3.6 deg off with 4 floor points 0.7-1.2 m beyond the shelf's end
+// among its own (11-14 cm before its plane, but within the refit's 5 cm of its tilted
+// extension, holding most of the lever). A point on the confirmed floor and off the plane
+// of the shelf's other points is the floor's: the shelf's fit leaves it out. Points at the
+// shelf's foot are on both and stay.
+TEST(PlaneMap, ACrossingPlanesPointsBeyondTheJoinAreNotThisPlanes) {
+  PlaneMap map;
+  for (unsigned k = 0; k < 5; ++k)
+    map.update({observe(kFloor, -0.8, 100 + 100 * k, 60, k, 3.0)}, 1000 + 0.1 * k);
+  ASSERT_EQ(map.planes().size(), 1u);
+  ASSERT_TRUE(map.planes()[0].confirmed(map.params()));
+  // The shelf front x = 2.7, 0.6 m wide (z 0-0.6), 1.5 cm noise; the floor points beyond
+  // its end (z 1.26-1.75), 10-13 cm before its plane.
+  const cv::Vec3d front(1, 0, 0);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> up(-0.8, 0.7), along(0.0, 0.6), beyond(1.26, 1.75),
+      before(0.10, 0.13);
+  std::normal_distribution<double> noise(0, 0.015), floor_noise(0, 0.003);
+  std::vector<cv::Vec3d> floor_points;
+  for (int i = 0; i < 4; ++i) floor_points.push_back({2.7 - before(rng), -0.8, beyond(rng)});
+  for (unsigned k = 0; k < 6; ++k) {
+    PlaneObservation shelf;
+    shelf.viewpoint = {0.7, 0.5, 0.2 * k};
+    for (int i = 0; i < 12; ++i) {
+      shelf.ids.push_back(5000 + 100 * k + i);
+      shelf.points.push_back({2.7 + noise(rng), up(rng), along(rng)});
+    }
+    for (int i = 0; i < 4; ++i) {  // the same floor tracks in every image
+      shelf.ids.push_back(9000 + i);
+      shelf.points.push_back(floor_points[i] + cv::Vec3d(0, floor_noise(rng), 0));
+    }
+    for (int i = 0; i < 3; ++i) {  // and three at the shelf's foot, on both planes
+      shelf.ids.push_back(9100 + i);
+      shelf.points.push_back({2.7 + floor_noise(rng), -0.8 + floor_noise(rng), 0.2 * i});
+    }
+    map.update({shelf}, 1001 + 0.1 * k);
+  }
+  const MapPlane* shelf = nullptr;
+  for (const MapPlane& p : map.planes())
+    if (std::min(normalAngleDeg(p.normal, front), normalAngleDeg(p.normal, -front)) < 20)
+      shelf = &p;
+  ASSERT_NE(shelf, nullptr);
+  EXPECT_LT(std::min(normalAngleDeg(shelf->normal, front), normalAngleDeg(shelf->normal, -front)),
+            1.0);
+  for (std::uint64_t id = 9000; id < 9004; ++id) EXPECT_EQ(shelf->points.count(id), 0u) << id;
+  for (std::uint64_t id = 9100; id < 9103; ++id) EXPECT_EQ(shelf->points.count(id), 1u) << id;
+}
