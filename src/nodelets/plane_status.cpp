@@ -2,6 +2,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
+#include <initializer_list>
 #include <iomanip>
 #include <sstream>
 
@@ -24,6 +25,11 @@ std::string degreesText(double deg) {
   std::ostringstream text;
   text << deg << " deg";
   return text.str();
+}
+
+void addValues(diagnostic_updater::DiagnosticStatusWrapper& status,
+               std::initializer_list<std::pair<const char*, long>> values) {
+  for (const auto& [key, value] : values) status.add(key, value);
 }
 
 // The odometry problems: one at most, the most telling first.
@@ -153,14 +159,14 @@ void reportPlaneStatus(const PlaneRunState& run, const PlaneStatusView& view,
   status.add("state", state);
   status.add("exceptions caught (total)", view.exceptions);
   if (view.exceptions > 0) status.add("last exception", view.last_exception);
-  status.add("camera switches (total)", run.camera_switches);
-  status.add("odometry refused (total)", run.refused_odom);
+  addValues(status, {{"camera switches (total)", run.camera_switches},
+                     {"odometry refused (total)", run.refused_odom}});
   if (!view.odom_frame.empty())
     status.add("odometry waited for in vain (total)", view.odom_waits_in_vain);
-  status.add("images processed", run.frames);
-  status.add("tracks messages dropped", run.dropped);
-  status.add("tracks missing from the stream (total)", run.missing_tracks);
-  status.add("camera_info messages rejected", run.dropped_info);
+  addValues(status, {{"images processed", run.frames},
+                     {"tracks messages dropped", run.dropped},
+                     {"tracks missing from the stream (total)", run.missing_tracks},
+                     {"camera_info messages rejected", run.dropped_info}});
   // The calibration of the last tracks' size (before any: the last camera_info).
   status.add("camera model", view.camera_model);
   status.add("tf", !run.tf_conflict.empty() ? "refused: " + run.tf_conflict
@@ -171,15 +177,16 @@ void reportPlaneStatus(const PlaneRunState& run, const PlaneStatusView& view,
                                   ? "none yet (" + view.metric_source_param + ")"
                                   : run.metric_source);
   status.add("map up (map/up_sigma_deg)", view.map_up);
-  status.add("tracks with camera_info of another size (total)", run.info_size_mismatch);
-  status.add("tracks with camera_info of another frame_id (total)", run.info_frame_mismatch);
   // Every start over of the map: ~reset calls and time going backwards (a bag loop).
-  status.add("resets (total)", run.resets);
-  status.add("resets: time went backwards (total)", run.backwards_resets);
-  status.add("resets: the tracker started over (total)", run.tracker_restarts);
-  status.add("reconfigurations (total)", run.reconfigures);
-  status.add("planes in this image", run.observed);
-  status.add("planes in the map", view.map_planes);
+  addValues(status,
+            {{"tracks with camera_info of another size (total)", run.info_size_mismatch},
+             {"tracks with camera_info of another frame_id (total)", run.info_frame_mismatch},
+             {"resets (total)", run.resets},
+             {"resets: time went backwards (total)", run.backwards_resets},
+             {"resets: the tracker started over (total)", run.tracker_restarts},
+             {"reconfigurations (total)", run.reconfigures},
+             {"planes in this image", static_cast<long>(run.observed)},
+             {"planes in the map", static_cast<long>(view.map_planes)}});
   if (view.landmarks) status.add("landmarks", *view.landmarks);
 }
 

@@ -407,6 +407,13 @@ diagnostic_updater::DiagnosticStatusWrapper planeStatus(const PlaneRunState& run
   return status;
 }
 
+PlaneRunState planeRun(PipelineState state, const std::string& status) {
+  PlaneRunState run;
+  run.state = state;
+  run.status = status;
+  return run;
+}
+
 PlaneStatusView planeView() {
   PlaneStatusView view;
   view.map_frame = "plane_map";
@@ -420,9 +427,7 @@ PlaneStatusView planeView() {
 // The plane nodelet's diagnostics when all is well: OK with the pipeline's status, and
 // its totals under their names.
 TEST(PlaneStatus, AllWellIsTheStatusWithTheTotals) {
-  PlaneRunState run;
-  run.state = PipelineState::kTracking;
-  run.status = "tracking (target)";
+  PlaneRunState run = planeRun(PipelineState::kTracking, "tracking (target)");
   run.metric_source = "target";
   run.tf_edge = "plane_map -> camera_estimate";
   run.frames = 120;
@@ -435,20 +440,22 @@ TEST(PlaneStatus, AllWellIsTheStatusWithTheTotals) {
   const auto status = planeStatus(run, view);
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK);
   EXPECT_EQ(status.message, "tracking (target)");
-  EXPECT_EQ(statusValue(status, "problems now"), "0");
-  EXPECT_EQ(statusValue(status, "state"), "tracking (target)");
-  EXPECT_EQ(statusValue(status, "images processed"), "120");
-  EXPECT_EQ(statusValue(status, "resets (total)"), "2");
-  EXPECT_EQ(statusValue(status, "resets: time went backwards (total)"), "1");
-  EXPECT_EQ(statusValue(status, "tf"), "plane_map -> camera_estimate");
-  EXPECT_EQ(statusValue(status, "metric source"), "target");
-  EXPECT_EQ(statusValue(status, "camera model"), "raw (K, D)");
-  EXPECT_EQ(statusValue(status, "map up (map/up_sigma_deg)"), "held to it (0.2 deg)");
-  EXPECT_EQ(statusValue(status, "planes in this image"), "3");
-  EXPECT_EQ(statusValue(status, "planes in the map"), "5");
-  EXPECT_EQ(statusValue(status, "landmarks"), "80");
-  // Only with odom_frame: the odometry waits.
-  EXPECT_EQ(statusValue(status, "odometry waited for in vain (total)"), "(none)");
+  const std::pair<const char*, const char*> expected[] = {
+      {"problems now", "0"},
+      {"state", "tracking (target)"},
+      {"images processed", "120"},
+      {"resets (total)", "2"},
+      {"resets: time went backwards (total)", "1"},
+      {"tf", "plane_map -> camera_estimate"},
+      {"metric source", "target"},
+      {"camera model", "raw (K, D)"},
+      {"map up (map/up_sigma_deg)", "held to it (0.2 deg)"},
+      {"planes in this image", "3"},
+      {"planes in the map", "5"},
+      {"landmarks", "80"},
+      {"odometry waited for in vain (total)", "(none)"},  // only with odom_frame
+  };
+  for (const auto& [key, value] : expected) EXPECT_EQ(statusValue(status, key), value) << key;
   // Before any tracks: said so, the configured source named, nothing published.
   PlaneStatusView before = planeView();
   before.publish_tf = true;
@@ -465,9 +472,7 @@ TEST(PlaneStatus, AllWellIsTheStatusWithTheTotals) {
 // Each problem under its key with its level; the worst, first added, is the summary.
 TEST(PlaneStatus, EachProblemHasItsLevelAndTheWorstIsTheSummary) {
   using diagnostic_msgs::DiagnosticStatus;
-  PlaneRunState run;
-  run.state = PipelineState::kLost;
-  run.status = "lost: 0.8 s without tracks";
+  PlaneRunState run = planeRun(PipelineState::kLost, "lost: 0.8 s without tracks");
   run.map_frame_shared = "plane_map -> odom";
   PlaneStatusView view = planeView();
   view.camera_info_overdue = true;
@@ -517,9 +522,7 @@ TEST(PlaneStatus, EachProblemHasItsLevelAndTheWorstIsTheSummary) {
 // depends on the metric source.
 TEST(PlaneStatus, OdometryProblemsSayWhatToLookAt) {
   using diagnostic_msgs::DiagnosticStatus;
-  PlaneRunState run;
-  run.state = PipelineState::kTracking;
-  run.status = "tracking (odometry)";
+  PlaneRunState run = planeRun(PipelineState::kTracking, "tracking (odometry)");
   run.metric_source = "odometry";
   PlaneStatusView view = planeView();
   view.odom_frame = "odom";
@@ -561,9 +564,7 @@ TEST(PlaneStatus, OdometryProblemsSayWhatToLookAt) {
 // target start that cannot finish: at once when the target left, after the timeout when
 // the camera does not move.
 TEST(PlaneStatus, AMetricStartThatDoesNotComeSaysWhatToDo) {
-  PlaneRunState run;
-  run.state = PipelineState::kWaitingForTarget;
-  run.status = "waiting for the start-up target";
+  PlaneRunState run = planeRun(PipelineState::kWaitingForTarget, "waiting for the start-up target");
   PlaneStatusView view = planeView();
   view.target_waited_s = 29;
   EXPECT_EQ(planeStatus(run, view).level, diagnostic_msgs::DiagnosticStatus::OK);
@@ -585,9 +586,7 @@ TEST(PlaneStatus, AMetricStartThatDoesNotComeSaysWhatToDo) {
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
   EXPECT_EQ(status.message, "start-up target: " + run.target_mismatch);
   // Initialising: the target gone for over 2 s, or no parallax for target_timeout_s.
-  run = PlaneRunState();
-  run.state = PipelineState::kInitialising;
-  run.status = "initialising";
+  run = planeRun(PipelineState::kInitialising, "initialising");
   view = planeView();
   run.start_target_unseen_s = 1.5;
   run.start_wait_s = 10;
