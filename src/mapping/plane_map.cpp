@@ -373,14 +373,18 @@ int PlaneMap::associate(const cv::Vec3d& normal, double distance,
 // plane more than 45 deg from this one holds it within its tolerance (coplanar_sigmas x
 // rms, in [min_residual_m, max_residual_m], as dropExplained weighs them), and the plane
 // of this plane's other points does not hold it within theirs. Points where the two meet
-// lie on both and stay (a floor seen along a wall's foot keeps them); with fewer than
-// min_points other points nothing is judged; and only points that turn the plane beyond
-// what its other points allow go (a lever, not noise: on the furnished room's humanoid
-// path, releasing every such point moved its floor 2.9 -> 3.1 % at noise seed 0).
-void PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged) const {
+// lie on both and stay (a floor seen along a wall's foot keeps them). Nothing is judged
+// when the other points fit no plane (too few, a line) or `with` (all of them) failed, and
+// nothing goes unless the candidates (join points too) turn the plane beyond what its
+// other points allow (a lever, not noise: on the furnished room's humanoid path,
+// releasing every such point moved its floor 2.9 -> 3.1 % at noise seed 0). True when
+// points left.
+bool PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged, const PlaneFit& with) const {
+  if (!with.ok) return false;
   auto tolerance = [&](double rms_m) {
-    return std::max(1e-9, std::clamp(params_.coplanar_sigmas * rms_m, params_.min_residual_m,
-                                     params_.max_residual_m));
+    return std::max(1e-9,
+                    std::min(params_.max_residual_m,
+                             std::max(params_.min_residual_m, params_.coplanar_sigmas * rms_m)));
   };
   std::vector<const MapPlane*> crossing;
   for (const MapPlane& other : planes_) {
@@ -388,7 +392,7 @@ void PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged) const {
     const double angle = normalAngleDeg(other.own_normal, plane.normal);
     if (std::min(angle, 180 - angle) > 45) crossing.push_back(&other);
   }
-  if (crossing.empty()) return;
+  if (crossing.empty()) return false;
   std::vector<std::uint64_t> candidates;
   std::vector<cv::Vec3d> others;
   for (const auto& [id, entry] : plane.points) {
@@ -403,23 +407,24 @@ void PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged) const {
     else
       others.push_back(x);
   }
-  if (candidates.empty()) return;
+  if (candidates.empty()) return false;
   const PlaneFit own = fitPlane(others, params_.max_residual_m, params_.min_points);
-  if (!own.ok) return;
+  if (!own.ok) return false;
   // They turn it beyond coplanar_sigmas x the normal sigma of its other points?
-  const PlaneFit with = fitPlane(positions(plane), params_.max_residual_m, params_.min_points);
-  if (with.ok) {
-    std::vector<cv::Vec3d> own_points;
-    for (int i : own.inliers) own_points.push_back(others[i]);
-    const double sigma = normalSigmaDeg(own_points, own.rms_m, params_.min_residual_m);
-    const double turn = normalAngleDeg(with.normal, own.normal);
-    if (std::min(turn, 180 - turn) <= params_.coplanar_sigmas * sigma) return;
-  }
+  std::vector<cv::Vec3d> own_points;
+  for (int i : own.inliers) own_points.push_back(others[i]);
+  const double sigma = normalSigmaDeg(own_points, own.rms_m, params_.min_residual_m);
+  const double turn = normalAngleDeg(with.normal, own.normal);
+  if (std::min(turn, 180 - turn) <= params_.coplanar_sigmas * sigma) return false;
   const double own_tolerance = tolerance(own.rms_m);
+  bool released = false;
   for (std::uint64_t id : candidates) {
     const cv::Vec3d& x = plane.points.at(id).first;
-    if (std::abs(own.normal.dot(x) - own.distance) > own_tolerance) plane.points.erase(id);
+    if (std::abs(own.normal.dot(x) - own.distance) <= own_tolerance) continue;
+    plane.points.erase(id);
+    released = true;
   }
+  return released;
 }
 
 bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) const {
@@ -431,9 +436,12 @@ bool PlaneMap::refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged) co
     for (size_t k = 0; plane.points.size() > params_.max_points_per_plane; ++k)
       plane.points.erase(by_age[k].second);
   }
-  releaseToCrossingPlanes(plane, merged);
-  const std::vector<cv::Vec3d> all = positions(plane);
+  std::vector<cv::Vec3d> all = positions(plane);
   PlaneFit fit = fitPlane(all, params_.max_residual_m, params_.min_points);
+  if (releaseToCrossingPlanes(plane, merged, fit)) {
+    all = positions(plane);
+    fit = fitPlane(all, params_.max_residual_m, params_.min_points);
+  }
   if (!fit.ok) return false;
   orientTowards(fit, viewpoint);
   if (normalAngleDeg(fit.normal, plane.normal) > 90) {  // keep the side first seen
@@ -570,8 +578,10 @@ void PlaneMap::dropExplained() {
       const double angle = normalAngleDeg(plane.own_normal, other.own_normal);
       const bool parallel = std::min(angle, 180 - angle) < kNearParallelDeg;
       near_parallel += parallel;
-      const double tolerance = std::clamp(params_.coplanar_sigmas * other.rms_m,
-                                          params_.min_residual_m, params_.max_residual_m);
+      // (min/max, not std::clamp: min_residual_m may exceed max_residual_m)
+      const double tolerance =
+          std::min(params_.max_residual_m,
+                   std::max(params_.min_residual_m, params_.coplanar_sigmas * other.rms_m));
       explainers.push_back({&other, std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
                             parallel});
     }

@@ -177,10 +177,10 @@ void reportPlaneStatus(const PlaneRunState& run, const PlaneStatusView& view,
                                   ? "none yet (" + view.metric_source_param + ")"
                                   : run.metric_source);
   status.add("map up (map/up_sigma_deg)", view.map_up);
-  // Every start over of the map: ~reset calls and time going backwards (a bag loop).
   addValues(status,
             {{"tracks with camera_info of another size (total)", run.info_size_mismatch},
              {"tracks with camera_info of another frame_id (total)", run.info_frame_mismatch},
+             // Every start over of the map: ~reset calls and time going backwards (a bag loop).
              {"resets (total)", run.resets},
              {"resets: time went backwards (total)", run.backwards_resets},
              {"resets: the tracker started over (total)", run.tracker_restarts},

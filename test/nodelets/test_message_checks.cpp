@@ -490,6 +490,7 @@ TEST(PlaneStatus, EachProblemHasItsLevelAndTheWorstIsTheSummary) {
   EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
   EXPECT_EQ(status.message, "tf conflict: camera_link already has the parent base_link");
   EXPECT_EQ(statusValue(status, "tf"), "refused: camera_link already has the parent base_link");
+  EXPECT_EQ(statusValue(status, "problems now"), "3");  // (the shared map frame not listed)
   // A configuration that gives no metres is an ERROR; refused values are then not listed.
   run = PlaneRunState();
   view = planeView();
@@ -502,6 +503,7 @@ TEST(PlaneStatus, EachProblemHasItsLevelAndTheWorstIsTheSummary) {
   EXPECT_EQ(status.level, DiagnosticStatus::ERROR);
   EXPECT_EQ(statusValue(status, "problem: configuration"),
             "ERROR: metric_source odometry needs odom_frame");
+  EXPECT_EQ(statusValue(status, "problems now"), "1");  // (the refused values not listed)
   // Exceptions, the stream and recent refusals: WARNs with their keys.
   view = planeView();
   view.exceptions = 2;

@@ -138,9 +138,9 @@ class PlaneMap {
   int associate(const cv::Vec3d& normal, double distance, const PlaneObservation& obs) const;
   // `merged`: the id of a plane merged into this one (not a reference for it).
   bool refit(MapPlane& plane, const cv::Vec3d& viewpoint, int merged = -1) const;
-  // Refit's first step: the points that a confirmed plane across this one explains better
-  // leave it (they are that plane's).
-  void releaseToCrossingPlanes(MapPlane& plane, int merged) const;
+  // Refit's first step: points on a confirmed plane across this one, off the plane of its
+  // other points, that turn it (`with`: the fit of all its points) leave it; true if any.
+  bool releaseToCrossingPlanes(MapPlane& plane, int merged, const PlaneFit& with) const;
   void mergeDuplicates(const cv::Vec3d& viewpoint);
   // Removes the planes whose points larger confirmed planes explain: a mixture of two of
   // their surfaces (fewer than min_points on none of them, and a strip of them on each of
