@@ -51,6 +51,15 @@ Spread spreadOf(const std::vector<cv::Vec3d>& points) {
   return out;
 }
 
+// The tolerance for a plane's points from its rms (or for one point from its sigma across
+// the plane): coplanar_sigmas x that, in [min_residual_m, max_residual_m] (min/max, not
+// std::clamp: min_residual_m may exceed max_residual_m), never 0 (it divides).
+double planeTolerance(const MapParams& params, double sigma_m) {
+  return std::max(1e-9,
+                  std::min(params.max_residual_m,
+                           std::max(params.min_residual_m, params.coplanar_sigmas * sigma_m)));
+}
+
 // Least-squares plane through points.
 bool leastSquares(const std::vector<cv::Vec3d>& points, cv::Vec3d& normal, double& distance) {
   if (points.size() < 3) return false;
@@ -134,8 +143,7 @@ std::vector<double> PlaneMap::tolerances(const PlaneObservation& obs,
       continue;
     }
     const double sigma = std::hypot(obs.sigma_m[i] * across, params_.min_residual_m / 3);
-    tol[i] = std::min(params_.max_residual_m,
-                      std::max(params_.min_residual_m, params_.coplanar_sigmas * sigma));
+    tol[i] = planeTolerance(params_, sigma);
   }
   return tol;
 }
@@ -381,27 +389,21 @@ int PlaneMap::associate(const cv::Vec3d& normal, double distance,
 // points left.
 bool PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged, const PlaneFit& with) const {
   if (!with.ok) return false;
-  auto tolerance = [&](double rms_m) {
-    return std::max(1e-9,
-                    std::min(params_.max_residual_m,
-                             std::max(params_.min_residual_m, params_.coplanar_sigmas * rms_m)));
-  };
-  std::vector<const MapPlane*> crossing;
+  std::vector<std::pair<const MapPlane*, double>> crossing;  // with its tolerance
   for (const MapPlane& other : planes_) {
     if (other.id == plane.id || other.id == merged || !other.confirmed(params_)) continue;
     const double angle = normalAngleDeg(other.own_normal, plane.normal);
-    if (std::min(angle, 180 - angle) > 45) crossing.push_back(&other);
+    if (std::min(angle, 180 - angle) > 45)
+      crossing.emplace_back(&other, planeTolerance(params_, other.rms_m));
   }
   if (crossing.empty()) return false;
   std::vector<std::uint64_t> candidates;
   std::vector<cv::Vec3d> others;
   for (const auto& [id, entry] : plane.points) {
     const cv::Vec3d& x = entry.first;
-    const bool on_crossing =
-        std::any_of(crossing.begin(), crossing.end(), [&](const MapPlane* other) {
-          return std::abs(other->own_normal.dot(x) - other->own_distance) <=
-                 tolerance(other->rms_m);
-        });
+    const bool on_crossing = std::any_of(crossing.begin(), crossing.end(), [&](const auto& c) {
+      return std::abs(c.first->own_normal.dot(x) - c.first->own_distance) <= c.second;
+    });
     if (on_crossing)
       candidates.push_back(id);
     else
@@ -416,7 +418,7 @@ bool PlaneMap::releaseToCrossingPlanes(MapPlane& plane, int merged, const PlaneF
   const double sigma = normalSigmaDeg(own_points, own.rms_m, params_.min_residual_m);
   const double turn = normalAngleDeg(with.normal, own.normal);
   if (std::min(turn, 180 - turn) <= params_.coplanar_sigmas * sigma) return false;
-  const double own_tolerance = tolerance(own.rms_m);
+  const double own_tolerance = planeTolerance(params_, own.rms_m);
   bool released = false;
   for (std::uint64_t id : candidates) {
     const cv::Vec3d& x = plane.points.at(id).first;
@@ -578,12 +580,7 @@ void PlaneMap::dropExplained() {
       const double angle = normalAngleDeg(plane.own_normal, other.own_normal);
       const bool parallel = std::min(angle, 180 - angle) < kNearParallelDeg;
       near_parallel += parallel;
-      // (min/max, not std::clamp: min_residual_m may exceed max_residual_m)
-      const double tolerance =
-          std::min(params_.max_residual_m,
-                   std::max(params_.min_residual_m, params_.coplanar_sigmas * other.rms_m));
-      explainers.push_back({&other, std::max(tolerance, 1e-9),  // (min_residual_m may be 0)
-                            parallel});
+      explainers.push_back({&other, planeTolerance(params_, other.rms_m), parallel});
     }
     if (near_parallel == 0) continue;
     on.assign(explainers.size(), 0);

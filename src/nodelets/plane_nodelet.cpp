@@ -782,9 +782,7 @@ class PlaneNodelet : public nodelet::Nodelet {
     view.odom_frame = odom_frame_;
     view.metric_source_param = node_.pipeline.pose.metric_source;
     view.config_blocked = metricSourceProblem(node_);
-    view.refused_params = start_errors_;
-    for (const std::string& e : reconfigure_errors_)
-      view.refused_params.push_back("reconfigure: " + e);
+    view.refused_params = refusedParams(start_errors_, reconfigure_errors_);
     view.odom_wait_s = odom_wait_s_;
     view.target_timeout_s = target_timeout_s_;
     view.publish_tf = publish_tf_;

@@ -74,4 +74,13 @@ inline std::string refusedParamsText(const std::vector<std::string>& errors) {
   return text;
 }
 
+// The parameters refused at start and by the last reconfigure ("reconfigure: ..."), for
+// refusedParamsText: both nodelets list them alike.
+inline std::vector<std::string> refusedParams(const std::vector<std::string>& at_start,
+                                              const std::vector<std::string>& by_reconfigure) {
+  std::vector<std::string> all = at_start;
+  for (const std::string& e : by_reconfigure) all.push_back("reconfigure: " + e);
+  return all;
+}
+
 }  // namespace mono_plane_detection

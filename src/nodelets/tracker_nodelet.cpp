@@ -286,12 +286,9 @@ class TrackerNodelet : public nodelet::Nodelet {
         "the subscriber queue overflowed: tracking is slower than the stream, e.g. under "
         "CPU load; or the driver or the network dropped them",
         "tracking starting over", "image"));
-    if (!config_errors_.empty() || !reconfigure_errors_.empty()) {
-      // (replaced by the defaults: after the present problems)
-      std::vector<std::string> all = config_errors_;
-      for (const std::string& e : reconfigure_errors_) all.push_back("reconfigure: " + e);
-      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(all));
-    }
+    // (replaced by the defaults: after the present problems)
+    if (const auto refused = refusedParams(config_errors_, reconfigure_errors_); !refused.empty())
+      problems.add(DiagnosticStatus::WARN, "configuration", refusedParamsText(refused));
     problems.addWarnings(problems_.recent(kRecentS), "last 10 s, ");
     problems.report(status, ok_text);
     status.add("points tracked", c.tracked_now);
